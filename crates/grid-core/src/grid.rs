@@ -1,0 +1,374 @@
+use glam::DVec2;
+
+use crate::{Error, Result};
+
+/// Cell value meaning "unknown" in [`OccupancyGrid::cells`].
+///
+/// Known cells hold their occupancy probability in percent, `0..=100`: the quantisation of
+/// `nav_msgs/OccupancyGrid`, so that the ROS int8 encoding converts losslessly both ways.
+pub const UNKNOWN: u8 = 255;
+
+/// A 2-D pose `(x, y, yaw)` in metres and radians (counter-clockwise), as in a map_server
+/// `origin:` entry.
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
+pub struct Pose2 {
+    /// x in metres.
+    pub x: f64,
+    /// y in metres.
+    pub y: f64,
+    /// Yaw in radians, counter-clockwise.
+    pub yaw: f64,
+}
+
+impl Pose2 {
+    /// A pose from its three components.
+    pub const fn new(x: f64, y: f64, yaw: f64) -> Self {
+        Self { x, y, yaw }
+    }
+}
+
+/// What a cell means once classified: free, occupied or unknown.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum CellState {
+    /// Probability at most [`OccupancyGrid::FREE_MAX_PERCENT`].
+    Free,
+    /// Probability at least [`OccupancyGrid::OCCUPIED_MIN_PERCENT`].
+    Occupied,
+    /// Unknown, or a probability between the two thresholds.
+    Unknown,
+}
+
+/// Counts of free, occupied and unknown cells (as classified by [`OccupancyGrid::state`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
+pub struct CellCounts {
+    /// Free cells.
+    pub free: usize,
+    /// Occupied cells.
+    pub occupied: usize,
+    /// Unknown cells, including probabilities between the thresholds.
+    pub unknown: usize,
+}
+
+/// Size, resolution and origin of a grid: everything needed to convert between pixel and world
+/// coordinates, without the cells.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GridGeometry {
+    /// Width in cells (image columns).
+    pub width: usize,
+    /// Height in cells (image rows).
+    pub height: usize,
+    /// Edge length of a cell in metres.
+    pub resolution: f64,
+    /// Pose of the lower-left corner of the lower-left cell (the last image row), ROS convention.
+    pub origin: Pose2,
+}
+
+impl GridGeometry {
+    /// World coordinates (metres, map frame) of pixel coordinates `p` (`x` column, `y` row from
+    /// the top, integer values at pixel centres).
+    pub fn pixel_to_world(&self, p: DVec2) -> DVec2 {
+        let r = self.resolution;
+        let local = DVec2::new((p.x + 0.5) * r, (self.height as f64 - 0.5 - p.y) * r);
+        DVec2::new(self.origin.x, self.origin.y) + DVec2::from_angle(self.origin.yaw).rotate(local)
+    }
+
+    /// Pixel coordinates of world point `w`; the inverse of [`Self::pixel_to_world`].
+    pub fn world_to_pixel(&self, w: DVec2) -> DVec2 {
+        let r = self.resolution;
+        let local = DVec2::from_angle(-self.origin.yaw)
+            .rotate(w - DVec2::new(self.origin.x, self.origin.y));
+        DVec2::new(local.x / r - 0.5, self.height as f64 - 0.5 - local.y / r)
+    }
+}
+
+/// A 2-D occupancy grid map.
+///
+/// Cells are stored row-major, row 0 being the top row of the image file. Each cell is
+/// [`UNKNOWN`] or an occupancy probability in percent (`0..=100`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct OccupancyGrid {
+    geometry: GridGeometry,
+    cells: Vec<u8>,
+}
+
+impl OccupancyGrid {
+    /// Probability (percent) at or below which a cell counts as free: map_saver's default.
+    pub const FREE_MAX_PERCENT: u8 = 25;
+    /// Probability (percent) at or above which a cell counts as occupied: map_saver's default.
+    pub const OCCUPIED_MIN_PERCENT: u8 = 65;
+
+    /// An all-unknown grid.
+    pub fn new(width: usize, height: usize, resolution: f64, origin: Pose2) -> Result<Self> {
+        Self::from_cells(
+            width,
+            height,
+            resolution,
+            origin,
+            vec![UNKNOWN; width * height],
+        )
+    }
+
+    /// A grid from row-major cells (`0..=100` percent or [`UNKNOWN`]; other values are taken as
+    /// unknown).
+    pub fn from_cells(
+        width: usize,
+        height: usize,
+        resolution: f64,
+        origin: Pose2,
+        mut cells: Vec<u8>,
+    ) -> Result<Self> {
+        if width == 0 || height == 0 {
+            return Err(Error::ZeroSize { width, height });
+        }
+        if !(resolution.is_finite() && resolution > 0.0) {
+            return Err(Error::Resolution(resolution));
+        }
+        if cells.len() != width * height {
+            return Err(Error::CellCount {
+                got: cells.len(),
+                expected: width * height,
+            });
+        }
+        for c in &mut cells {
+            if *c > 100 {
+                *c = UNKNOWN;
+            }
+        }
+        Ok(Self {
+            geometry: GridGeometry {
+                width,
+                height,
+                resolution,
+                origin,
+            },
+            cells,
+        })
+    }
+
+    /// A grid from the `nav_msgs/OccupancyGrid` int8 encoding (`-1` unknown, `0..=100` percent).
+    ///
+    /// Note that `nav_msgs/OccupancyGrid` stores rows bottom-up (row 0 is at the origin) while
+    /// this grid stores them top-down like the image file; this conversion flips the rows.
+    pub fn from_ros_data(
+        width: usize,
+        height: usize,
+        resolution: f64,
+        origin: Pose2,
+        data: &[i8],
+    ) -> Result<Self> {
+        if data.len() != width * height {
+            return Err(Error::CellCount {
+                got: data.len(),
+                expected: width * height,
+            });
+        }
+        let mut cells = vec![UNKNOWN; data.len()];
+        for (index, &value) in data.iter().enumerate() {
+            let cell = match value {
+                -1 => UNKNOWN,
+                0..=100 => value as u8,
+                _ => return Err(Error::OccupancyValue { value, index }),
+            };
+            let (x, y_ros) = (index % width, index / width);
+            cells[(height - 1 - y_ros) * width + x] = cell;
+        }
+        Self::from_cells(width, height, resolution, origin, cells)
+    }
+
+    /// The `nav_msgs/OccupancyGrid` int8 encoding of this grid (rows bottom-up, as ROS has them).
+    pub fn to_ros_data(&self) -> Vec<i8> {
+        let (w, h) = (self.width(), self.height());
+        let mut data = Vec::with_capacity(w * h);
+        for y_ros in 0..h {
+            let row = &self.cells[(h - 1 - y_ros) * w..(h - y_ros) * w];
+            data.extend(row.iter().map(|&c| if c == UNKNOWN { -1 } else { c as i8 }));
+        }
+        data
+    }
+
+    /// Width in cells.
+    pub fn width(&self) -> usize {
+        self.geometry.width
+    }
+
+    /// Height in cells.
+    pub fn height(&self) -> usize {
+        self.geometry.height
+    }
+
+    /// Cell edge length in metres.
+    pub fn resolution(&self) -> f64 {
+        self.geometry.resolution
+    }
+
+    /// Pose of the lower-left corner of the lower-left cell.
+    pub fn origin(&self) -> Pose2 {
+        self.geometry.origin
+    }
+
+    /// Size, resolution and origin.
+    pub fn geometry(&self) -> GridGeometry {
+        self.geometry
+    }
+
+    /// Replace the origin pose.
+    pub fn set_origin(&mut self, origin: Pose2) {
+        self.geometry.origin = origin;
+    }
+
+    /// Row-major cells, [`UNKNOWN`] or percent.
+    pub fn cells(&self) -> &[u8] {
+        &self.cells
+    }
+
+    /// Mutable row-major cells. Writing a value above 100 other than [`UNKNOWN`] is a logic
+    /// error; readers treat it as unknown.
+    pub fn cells_mut(&mut self) -> &mut [u8] {
+        &mut self.cells
+    }
+
+    /// Raw cell value at column `x`, row `y`, or `None` outside the grid.
+    #[inline]
+    pub fn get(&self, x: usize, y: usize) -> Option<u8> {
+        (x < self.width() && y < self.height()).then(|| self.cells[y * self.width() + x])
+    }
+
+    /// Occupancy probability in `[0, 1]` at `(x, y)`, `None` when unknown or outside.
+    #[inline]
+    pub fn probability(&self, x: usize, y: usize) -> Option<f32> {
+        match self.get(x, y)? {
+            c if c <= 100 => Some(c as f32 / 100.0),
+            _ => None,
+        }
+    }
+
+    /// Set the cell at `(x, y)` to a probability (clamped to `[0, 1]`, rounded to percent) or to
+    /// unknown. Panics outside the grid, like slice indexing.
+    pub fn set_probability(&mut self, x: usize, y: usize, p: Option<f32>) {
+        let w = self.width();
+        assert!(
+            x < w && y < self.height(),
+            "cell ({x}, {y}) outside the grid"
+        );
+        self.cells[y * w + x] = match p {
+            Some(p) if p.is_finite() => (p.clamp(0.0, 1.0) * 100.0).round() as u8,
+            _ => UNKNOWN,
+        };
+    }
+
+    /// Classify a raw cell value.
+    #[inline]
+    pub fn classify(cell: u8) -> CellState {
+        match cell {
+            c if c <= Self::FREE_MAX_PERCENT => CellState::Free,
+            c if (Self::OCCUPIED_MIN_PERCENT..=100).contains(&c) => CellState::Occupied,
+            _ => CellState::Unknown,
+        }
+    }
+
+    /// Classified state at `(x, y)`; outside the grid is unknown.
+    #[inline]
+    pub fn state(&self, x: usize, y: usize) -> CellState {
+        self.get(x, y).map_or(CellState::Unknown, Self::classify)
+    }
+
+    /// Number of free, occupied and unknown cells.
+    pub fn counts(&self) -> CellCounts {
+        let mut counts = CellCounts::default();
+        for &c in &self.cells {
+            match Self::classify(c) {
+                CellState::Free => counts.free += 1,
+                CellState::Occupied => counts.occupied += 1,
+                CellState::Unknown => counts.unknown += 1,
+            }
+        }
+        counts
+    }
+
+    /// World coordinates of pixel coordinates `p`; see [`GridGeometry::pixel_to_world`].
+    pub fn pixel_to_world(&self, p: DVec2) -> DVec2 {
+        self.geometry.pixel_to_world(p)
+    }
+
+    /// Pixel coordinates of world point `w`; see [`GridGeometry::world_to_pixel`].
+    pub fn world_to_pixel(&self, w: DVec2) -> DVec2 {
+        self.geometry.world_to_pixel(w)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    #[test]
+    fn zero_size_is_refused() {
+        assert!(matches!(
+            OccupancyGrid::new(0, 3, 0.05, Pose2::default()),
+            Err(Error::ZeroSize {
+                width: 0,
+                height: 3
+            })
+        ));
+    }
+
+    #[test]
+    fn ros_data_flips_rows() {
+        // 2 x 2: top row [0, 100], bottom row [unknown, 50].
+        let g = OccupancyGrid::from_cells(2, 2, 0.1, Pose2::default(), vec![0, 100, UNKNOWN, 50])
+            .unwrap();
+        assert_eq!(g.to_ros_data(), vec![-1, 50, 0, 100]);
+    }
+
+    #[test]
+    fn ros_data_rejects_out_of_range() {
+        let err = OccupancyGrid::from_ros_data(2, 1, 0.1, Pose2::default(), &[0, 101]).unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "occupancy value 101 at index 1 is outside -1..=100"
+        );
+    }
+
+    #[test]
+    fn pixel_centre_to_world_follows_conventions() {
+        // W x H = 4 x 3, r = 0.5, origin (1, 2, 0): pixel (0, 2) is the lower-left cell.
+        let geo = GridGeometry {
+            width: 4,
+            height: 3,
+            resolution: 0.5,
+            origin: Pose2::new(1.0, 2.0, 0.0),
+        };
+        assert_eq!(
+            geo.pixel_to_world(DVec2::new(0.0, 2.0)),
+            DVec2::new(1.25, 2.25)
+        );
+        assert_eq!(
+            geo.pixel_to_world(DVec2::new(3.0, 0.0)),
+            DVec2::new(2.75, 3.25)
+        );
+    }
+
+    proptest! {
+        #[test]
+        fn ros_int8_round_trip(w in 1usize..20, h in 1usize..20, seed in any::<u64>()) {
+            let mut s = seed;
+            let data: Vec<i8> = (0..w * h).map(|_| {
+                s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                ((s >> 33) % 102) as i8 - 1
+            }).collect();
+            let g = OccupancyGrid::from_ros_data(w, h, 0.05, Pose2::new(1.0, -2.0, 0.3), &data).unwrap();
+            prop_assert_eq!(g.to_ros_data(), data);
+            let back = OccupancyGrid::from_ros_data(w, h, 0.05, g.origin(), &g.to_ros_data()).unwrap();
+            prop_assert_eq!(back, g);
+        }
+
+        #[test]
+        fn pixel_world_round_trip(x in -50.0f64..500.0, y in -50.0f64..500.0, ox in -20.0f64..20.0,
+                                  oy in -20.0f64..20.0, yaw in -3.2f64..3.2, r in 0.01f64..1.0) {
+            let geo = GridGeometry { width: 300, height: 200, resolution: r, origin: Pose2::new(ox, oy, yaw) };
+            let p = DVec2::new(x, y);
+            let back = geo.world_to_pixel(geo.pixel_to_world(p));
+            prop_assert!((back - p).length() < 1e-8, "{p} -> {back}");
+        }
+    }
+}
