@@ -1,6 +1,6 @@
 use glam::DVec2;
 
-use crate::{Error, Result};
+use crate::{Error, Result, Rigid2};
 
 /// Cell value meaning "unknown" in [`OccupancyGrid::cells`].
 ///
@@ -285,6 +285,28 @@ impl OccupancyGrid {
         counts
     }
 
+    /// Resample this grid onto a `width x height` canvas with `self_to_out` (nearest neighbour):
+    /// output cell `p` takes the cell of `self` at `self_to_out.inverse()(p)`, unknown outside.
+    /// Resolution and origin are kept; the caller sets the origin it needs.
+    pub fn warp(&self, self_to_out: &Rigid2, width: usize, height: usize) -> Result<Self> {
+        let inv = self_to_out.inverse();
+        let (s, c) = inv.theta.sin_cos();
+        let mut cells = vec![UNKNOWN; width * height];
+        for (y, row) in cells.chunks_mut(width.max(1)).enumerate() {
+            for (x, cell) in row.iter_mut().enumerate() {
+                let (xf, yf) = (x as f64, y as f64);
+                let sx = (c * xf - s * yf + inv.tx).round();
+                let sy = (s * xf + c * yf + inv.ty).round();
+                if sx >= 0.0 && sy >= 0.0 {
+                    if let Some(v) = self.get(sx as usize, sy as usize) {
+                        *cell = v;
+                    }
+                }
+            }
+        }
+        Self::from_cells(width, height, self.resolution(), self.origin(), cells)
+    }
+
     /// World coordinates of pixel coordinates `p`; see [`GridGeometry::pixel_to_world`].
     pub fn pixel_to_world(&self, p: DVec2) -> DVec2 {
         self.geometry.pixel_to_world(p)
@@ -346,6 +368,17 @@ mod tests {
             geo.pixel_to_world(DVec2::new(3.0, 0.0)),
             DVec2::new(2.75, 3.25)
         );
+    }
+
+    #[test]
+    fn warp_by_quarter_turn() {
+        // 3 x 2 map, cells 0..6 as distinct percents; turned by +90 deg into a 2 x 3 canvas.
+        let g = OccupancyGrid::from_cells(3, 2, 0.05, Pose2::default(), vec![0, 1, 2, 3, 4, 5])
+            .unwrap();
+        let t = Rigid2::new(std::f64::consts::FRAC_PI_2, 1.0, 0.0);
+        let w = g.warp(&t, 2, 3).unwrap();
+        // B (x, y) -> A (1 - y, x): A row 0 = [B(0,1), B(0,0)], row 1 = [B(1,1), B(1,0)], ...
+        assert_eq!(w.cells(), &[3, 0, 4, 1, 5, 2]);
     }
 
     proptest! {

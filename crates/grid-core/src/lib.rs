@@ -13,6 +13,7 @@
 mod error;
 mod grid;
 pub mod io;
+pub mod metrics;
 mod traits;
 mod transform;
 
