@@ -1,0 +1,214 @@
+//! From a grid to blobs: mask, closing, labelling, moments, descriptors.
+
+use grid_core::{FeatureExtractor, OccupancyGrid};
+
+use crate::label::{Connectivity, Labeler};
+use crate::moments::{Accumulator, Shape, accumulate};
+use crate::{close, obstacle_mask};
+
+/// Length of the descriptor array of a [`Blob`] (unused trailing entries are zero).
+pub const DESCRIPTOR_LEN: usize = 8;
+
+/// Which rotation-invariant quantities make up a blob's descriptor. All entries are logarithms
+/// (or log-scaled Hu invariants) so that a difference of 0.1 is about a 10 % change.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum DescriptorKind {
+    /// `[ln area, ln sqrt(major), ln sqrt(minor)]`: size and the two axis lengths.
+    #[default]
+    Axes,
+    /// [`DescriptorKind::Axes`] plus `ln(perimeter / sqrt(area))` (compactness).
+    AxesPerimeter,
+    /// `[ln area, hu1 .. hu7]`: Hu's invariants (log-scaled) and size.
+    Hu,
+    /// [`DescriptorKind::Axes`] plus log-scaled `hu3 .. hu4` (the skew of the shape).
+    AxesHu,
+}
+
+impl DescriptorKind {
+    /// Number of used entries.
+    pub fn dim(self) -> usize {
+        match self {
+            Self::Axes => 3,
+            Self::AxesPerimeter => 4,
+            Self::Hu => 8,
+            Self::AxesHu => 5,
+        }
+    }
+
+    fn compute(self, s: &Shape) -> [f64; DESCRIPTOR_LEN] {
+        let mut d = [0.0; DESCRIPTOR_LEN];
+        let la = (s.area as f64).ln();
+        // Eigenvalues are at least 1/12 thanks to the unit-square term, so the logs are finite.
+        let major = 0.5 * s.eigenvalues[0].max(1.0 / 12.0).ln();
+        let minor = 0.5 * s.eigenvalues[1].max(1.0 / 12.0).ln();
+        match self {
+            Self::Axes => d[..3].copy_from_slice(&[la, major, minor]),
+            Self::AxesPerimeter => {
+                let compact = (s.perimeter.max(1) as f64 / (s.area as f64).sqrt()).ln();
+                d[..4].copy_from_slice(&[la, major, minor, compact]);
+            }
+            Self::Hu => {
+                d[0] = la;
+                d[1..8].copy_from_slice(&s.hu);
+            }
+            Self::AxesHu => {
+                // Hu's log scale spans decades; a tenth brings it near the other entries.
+                d[..5].copy_from_slice(&[la, major, minor, 0.1 * s.hu[2], 0.1 * s.hu[3]]);
+            }
+        }
+        d
+    }
+}
+
+/// What to do with components that border unknown space (their shape may continue where the
+/// robot did not look).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum UnknownPolicy {
+    /// Treat them like any other component.
+    Keep,
+    /// Scale their reliability by `1 - unknown_contact` (floored at 0.05).
+    #[default]
+    Downweight,
+    /// Drop components whose unknown contact exceeds the given fraction.
+    Drop(f64),
+}
+
+/// Extraction settings. The defaults were chosen by the measurements in the crate's tests and
+/// `examples/`; see the README of the crate's report for the numbers.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BlobConfig {
+    /// Component connectivity. Default [`Connectivity::Eight`]: diagonal walls stay whole.
+    pub connectivity: Connectivity,
+    /// Radius (px) of the morphological closing applied to the obstacle mask before labelling,
+    /// so that a wall drawn with gaps by a noisy sensor stays one component. Default 1.
+    pub close_radius: usize,
+    /// Components with fewer pixels are dropped (noise specks). Default 12.
+    pub min_area: usize,
+    /// Above this `minor / major` eigenvalue ratio a component counts as round and gets no
+    /// orientation. Default 0.8.
+    pub round_ratio: f64,
+    /// Handling of components that border unknown cells. Default [`UnknownPolicy::Downweight`].
+    pub unknown: UnknownPolicy,
+    /// Descriptor used for matching. Default [`DescriptorKind::Axes`].
+    pub descriptor: DescriptorKind,
+}
+
+impl Default for BlobConfig {
+    fn default() -> Self {
+        Self {
+            connectivity: Connectivity::Eight,
+            close_radius: 1,
+            min_area: 12,
+            round_ratio: 0.8,
+            unknown: UnknownPolicy::Downweight,
+            descriptor: DescriptorKind::Axes,
+        }
+    }
+}
+
+/// An area keypoint: one connected component of obstacle cells.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Blob {
+    /// Label of the component in the label image (`1..=n`).
+    pub label: u32,
+    /// Moments and shape statistics.
+    pub shape: Shape,
+    /// Major-axis angle in `(-pi/2, pi/2]` (period pi), `None` when the component is too round
+    /// (see [`BlobConfig::round_ratio`]).
+    pub orientation: Option<f64>,
+    /// Trust in `(0, 1]` (lowered by unknown contact, see [`UnknownPolicy`]).
+    pub reliability: f64,
+    /// Rotation-invariant descriptor ([`BlobConfig::descriptor`]), zero-padded.
+    pub descriptor: [f64; DESCRIPTOR_LEN],
+}
+
+/// Caller-owned buffers for [`Blobs::extract_with`], reused across maps.
+#[derive(Debug, Clone, Default)]
+pub struct BlobScratch {
+    mask: Vec<u8>,
+    tmp: Vec<u8>,
+    labels: Vec<u32>,
+    labeler: Labeler,
+    acc: Vec<Accumulator>,
+}
+
+impl BlobScratch {
+    /// The label image of the last extraction (`0` background), row-major.
+    pub fn labels(&self) -> &[u32] {
+        &self.labels
+    }
+
+    /// The (closed) obstacle mask of the last extraction, row-major.
+    pub fn mask(&self) -> &[u8] {
+        &self.mask
+    }
+}
+
+/// Blob extractor: implements [`FeatureExtractor`] with `Feature = Blob`.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Blobs {
+    /// Settings.
+    pub config: BlobConfig,
+}
+
+impl Blobs {
+    /// An extractor with the given settings.
+    pub fn new(config: BlobConfig) -> Self {
+        Self { config }
+    }
+
+    /// Append the blobs of `grid` to `out`, using `scratch` for all intermediate buffers.
+    pub fn extract_with(
+        &self,
+        grid: &OccupancyGrid,
+        scratch: &mut BlobScratch,
+        out: &mut Vec<Blob>,
+    ) {
+        let c = &self.config;
+        let (w, h) = (grid.width(), grid.height());
+        obstacle_mask(grid, &mut scratch.mask);
+        close(&mut scratch.mask, w, h, c.close_radius, &mut scratch.tmp);
+        scratch.labeler.set_connectivity(c.connectivity);
+        // The mask has w * h entries by construction and a grid holds at most what fits in
+        // memory; the only possible error is an image beyond 32-bit labels, which yields no blob.
+        let Ok(n) = scratch
+            .labeler
+            .label(&scratch.mask, w, h, &mut scratch.labels)
+        else {
+            return;
+        };
+        accumulate(&scratch.labels, n, grid, &mut scratch.acc);
+        for (i, acc) in scratch.acc.iter().enumerate() {
+            if acc.area() < c.min_area.max(1) {
+                continue;
+            }
+            let shape = acc.shape();
+            let reliability = match c.unknown {
+                UnknownPolicy::Keep => 1.0,
+                UnknownPolicy::Downweight => (1.0 - shape.unknown_contact).max(0.05),
+                UnknownPolicy::Drop(max) => {
+                    if shape.unknown_contact > max {
+                        continue;
+                    }
+                    1.0
+                }
+            };
+            out.push(Blob {
+                label: i as u32 + 1,
+                orientation: (shape.roundness() <= c.round_ratio).then_some(shape.axis_angle),
+                reliability,
+                descriptor: c.descriptor.compute(&shape),
+                shape,
+            });
+        }
+    }
+}
+
+impl FeatureExtractor for Blobs {
+    type Feature = Blob;
+
+    /// Allocates fresh scratch buffers; use [`Blobs::extract_with`] in loops.
+    fn extract(&self, grid: &OccupancyGrid, out: &mut Vec<Blob>) {
+        self.extract_with(grid, &mut BlobScratch::default(), out);
+    }
+}

@@ -1,0 +1,31 @@
+//! Area keypoints for mapmerge: connected components of obstacle cells ("blobs"), their shape
+//! moments, and matching them between two maps.
+//!
+//! When two robots sense differently (a failed sensor, a larger noise bound) intensity keypoints
+//! become unstable, but obstacles still agree. Each matched pair of components fixes a full rigid
+//! hypothesis on its own: the rotation from the difference of the major-axis angles (modulo pi)
+//! and the translation from the centroids. This crate produces those matches as
+//! [`grid_core::Correspondence`]s with `kind: EvidenceKind::Area` and an orientation of period
+//! pi; it is not a robust estimator (that is `ransac-rigid`'s job) and it does not read map files.
+//!
+//! Pipeline: [`obstacle_mask`] (+ optional [`close`]) → [`Labeler::label`] → per-component
+//! [`Shape`] → [`Blob`] (orientation, reliability, rotation-invariant descriptor) →
+//! [`match_blobs`]. [`Blobs`] implements [`grid_core::FeatureExtractor`] and
+//! [`BlobCorrespondences`] implements [`grid_core::CorrespondenceSource`]; to match one map
+//! against many, extract once with [`Blobs::extract_with`] and call [`match_blobs`] per pair.
+
+mod error;
+mod extract;
+mod label;
+mod mask;
+mod matching;
+mod moments;
+
+pub use error::{BlobError, Result};
+pub use extract::{
+    Blob, BlobConfig, BlobScratch, Blobs, DESCRIPTOR_LEN, DescriptorKind, UnknownPolicy,
+};
+pub use label::{Connectivity, Labeler};
+pub use mask::{close, obstacle_mask};
+pub use matching::{BlobCorrespondences, MatchConfig, match_blobs};
+pub use moments::{BoundingBox, Shape};

@@ -1,0 +1,183 @@
+//! Obstacle masks: which cells take part in connected components, and morphological closing so
+//! that a wall drawn with gaps by a noisy sensor stays one component.
+
+use grid_core::{CellState, OccupancyGrid};
+
+/// Write the obstacle mask of `grid` into `out` (cleared first): `1` where
+/// [`OccupancyGrid::state`] is [`CellState::Occupied`], `0` elsewhere; row-major like the grid.
+pub fn obstacle_mask(grid: &OccupancyGrid, out: &mut Vec<u8>) {
+    out.clear();
+    out.extend(
+        grid.cells()
+            .iter()
+            .map(|&c| u8::from(OccupancyGrid::classify(c) == CellState::Occupied)),
+    );
+}
+
+/// Morphological closing (dilation then erosion) of a `0`/`1` mask by a `(2r+1) x (2r+1)` square,
+/// in place; `scratch` is a caller-owned buffer. `radius == 0` leaves the mask unchanged.
+///
+/// The mask is closed as if surrounded by background, so closing never thickens an obstacle
+/// that runs along the border. A square element (not a disk) keeps the passes separable and
+/// linear in the pixel count whatever the radius; for the radii that matter here (1-2 px) the
+/// two differ by a handful of corner pixels.
+///
+/// Panics if `mask.len() != width * height`.
+pub fn close(mask: &mut [u8], width: usize, height: usize, radius: usize, scratch: &mut Vec<u8>) {
+    assert_eq!(mask.len(), width * height, "mask size");
+    if radius == 0 || mask.is_empty() {
+        return;
+    }
+    // Pad by the radius so the dilation may spill over the border and the erosion can take it
+    // back; then work on the padded copy.
+    let (pw, ph) = (width + 2 * radius, height + 2 * radius);
+    scratch.clear();
+    scratch.resize(2 * pw * ph, 0);
+    let (padded, tmp) = scratch.split_at_mut(pw * ph);
+    for (y, row) in mask.chunks_exact(width).enumerate() {
+        let at = (y + radius) * pw + radius;
+        padded[at..at + width].copy_from_slice(row);
+    }
+    dilate(padded, tmp, pw, ph, radius);
+    // Erosion = complement of the dilation of the complement. Outside the padding counts as
+    // foreground here, which only matters for padding pixels, never read back.
+    for m in padded.iter_mut() {
+        *m ^= 1;
+    }
+    dilate(padded, tmp, pw, ph, radius);
+    for (y, row) in mask.chunks_exact_mut(width).enumerate() {
+        let at = (y + radius) * pw + radius;
+        for (m, &p) in row.iter_mut().zip(&padded[at..at + width]) {
+            *m = p ^ 1;
+        }
+    }
+}
+
+/// Dilation of a `0`/`1` mask by a `(2r+1)` square, in place (outside counts as background);
+/// `tmp` has the mask's size.
+fn dilate(mask: &mut [u8], tmp: &mut [u8], width: usize, height: usize, r: usize) {
+    // Rows: tmp[x] = any(mask[x-r ..= x+r]).
+    for (src, dst) in mask.chunks_exact(width).zip(tmp.chunks_exact_mut(width)) {
+        window_any(src, dst, r);
+    }
+    // Columns, from tmp back into the mask, with a running count per column so that the inner
+    // loop walks memory row by row.
+    let mut count = vec![0u32; width];
+    for y in 0..height.min(r) {
+        add_row(&mut count, &tmp[y * width..(y + 1) * width]);
+    }
+    for y in 0..height {
+        if y + r < height {
+            add_row(&mut count, &tmp[(y + r) * width..(y + r + 1) * width]);
+        }
+        if y > r {
+            let old = y - r - 1;
+            for (c, &s) in count.iter_mut().zip(&tmp[old * width..(old + 1) * width]) {
+                *c -= s as u32;
+            }
+        }
+        for (m, &c) in mask[y * width..(y + 1) * width].iter_mut().zip(&count) {
+            *m = u8::from(c > 0);
+        }
+    }
+}
+
+fn add_row(count: &mut [u32], row: &[u8]) {
+    for (c, &s) in count.iter_mut().zip(row) {
+        *c += s as u32;
+    }
+}
+
+/// `dst[x] = 1` when any of `src[x-r ..= x+r]` (clipped) is set.
+fn window_any(src: &[u8], dst: &mut [u8], r: usize) {
+    let n = src.len();
+    let mut last: Option<usize> = None;
+    for x in 0..n {
+        if src[x] != 0 {
+            last = Some(x);
+        }
+        dst[x] = u8::from(last.is_some_and(|l| x - l <= r));
+    }
+    let mut next: Option<usize> = None;
+    for x in (0..n).rev() {
+        if src[x] != 0 {
+            next = Some(x);
+        }
+        if next.is_some_and(|l| l - x <= r) {
+            dst[x] = 1;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Closing by brute force: dilation then erosion with explicit window loops.
+    fn close_oracle(mask: &[u8], w: usize, h: usize, r: usize) -> Vec<u8> {
+        let get = |m: &[u8], x: isize, y: isize, outside: u8| {
+            if x < 0 || y < 0 || x >= w as isize || y >= h as isize {
+                outside
+            } else {
+                m[y as usize * w + x as usize]
+            }
+        };
+        let r = r as isize;
+        // Closing on the infinite plane of background: the dilation is evaluated outside the
+        // image too (the erosion of an in-image pixel reads it there).
+        let mut out = vec![0u8; w * h];
+        for y in 0..h as isize {
+            for x in 0..w as isize {
+                let mut all = true;
+                for dy in -r..=r {
+                    for dx in -r..=r {
+                        let mut any = false;
+                        for ey in -r..=r {
+                            for ex in -r..=r {
+                                any |= get(mask, x + dx + ex, y + dy + ey, 0) != 0;
+                            }
+                        }
+                        all &= any;
+                    }
+                }
+                out[y as usize * w + x as usize] = u8::from(all);
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn closing_matches_brute_force() {
+        let (w, h) = (23, 17);
+        let mut s = 12345u64;
+        for r in 0..4 {
+            let mask: Vec<u8> = (0..w * h)
+                .map(|_| {
+                    s = s
+                        .wrapping_mul(6364136223846793005)
+                        .wrapping_add(1442695040888963407);
+                    u8::from((s >> 33) % 5 == 0)
+                })
+                .collect();
+            let mut m = mask.clone();
+            close(&mut m, w, h, r, &mut Vec::new());
+            assert_eq!(m, close_oracle(&mask, w, h, r), "radius {r}");
+        }
+    }
+
+    #[test]
+    fn closing_bridges_a_one_pixel_gap() {
+        // A horizontal wall with a gap at x = 5: radius 1 bridges it.
+        let (w, h) = (11, 3);
+        let mut m = vec![0u8; w * h];
+        for x in (0..w).filter(|&x| x != 5) {
+            m[w + x] = 1;
+        }
+        close(&mut m, w, h, 1, &mut Vec::new());
+        assert!(m[w..2 * w].iter().all(|&v| v == 1));
+        assert!(
+            m[..w].iter().all(|&v| v == 0),
+            "closing must not thicken the wall"
+        );
+    }
+}
