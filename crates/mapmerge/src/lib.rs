@@ -1,0 +1,14 @@
+//! The mapmerge pipeline: register occupancy grid maps of a robot team without initial guesses.
+//!
+//! It is for: composing the feature crates (`sift-desc`, `blob-features`), the hypothesis
+//! generator (`ransac-rigid`) and the checks on the maps themselves (refinement, verification)
+//! into one call per pair, [`register_with`]. It is not for: file formats (see
+//! `grid_core::io`) or the command line (the `mapmerge` binary in this package).
+
+pub mod distance;
+pub mod global;
+pub mod refine;
+mod register;
+pub mod verify;
+
+pub use register::{Candidate, KindTotals, PairConfig, Registration, Timings, register_with};

@@ -1,0 +1,227 @@
+//! Checking a hypothesis against the maps themselves, so that a pair without real overlap is
+//! declined instead of returning a confident wrong answer.
+//!
+//! Raw RANSAC inlier counts say how many feature matches agree; they do not say whether the two
+//! maps agree. A wrong hypothesis on repetitive structure, or any hypothesis for two maps that
+//! do not overlap, can gather a handful of inliers. So each candidate is scored on the cells:
+//! - *wall agreement*: of B's occupied cells that land on known cells of A, the share within
+//!   `wall_tolerance_px` of an occupied cell of A (and symmetrically A onto B), lifted over the
+//!   share a random placement would reach (the fraction of known cells near walls);
+//! - *acceptance index* (Birk & Carpin 2006) over sampled cells known in both maps;
+//! - *overlap*: how many known cells the maps share under the hypothesis.
+
+use grid_core::{CellState, DVec2, OccupancyGrid, Rigid2};
+
+use crate::distance::NearestOccupied;
+
+/// Thresholds of the verification, with documented defaults.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VerifyConfig {
+    /// A wall cell counts as matched within this distance of a wall of the other map. Default 2.0.
+    pub wall_tolerance_px: f32,
+    /// At most this many wall cells and known cells are sampled per map. Default 20 000.
+    pub max_samples: usize,
+    /// Minimum wall lift (see [`Verification::wall_lift`]) to accept. Default 0.35.
+    pub min_wall_lift: f64,
+    /// Minimum acceptance index to accept. Default 0.80.
+    pub min_acceptance_index: f64,
+    /// Minimum number of wall cells compared (both directions together). Default 40.
+    pub min_wall_support: usize,
+    /// Minimum overlap, as a fraction of the smaller map's known cells. Default 0.03.
+    pub min_overlap_fraction: f64,
+}
+
+impl Default for VerifyConfig {
+    fn default() -> Self {
+        Self {
+            wall_tolerance_px: 2.0,
+            max_samples: 20_000,
+            min_wall_lift: 0.35,
+            min_acceptance_index: 0.80,
+            min_wall_support: 40,
+            min_overlap_fraction: 0.03,
+        }
+    }
+}
+
+/// A map with what verification and refinement need precomputed once.
+#[derive(Debug)]
+pub struct PreparedMap<'a> {
+    /// The map.
+    pub grid: &'a OccupancyGrid,
+    /// Nearest occupied cell of every cell.
+    pub walls: NearestOccupied,
+    /// Sampled occupied cells (pixel centres).
+    pub wall_samples: Vec<DVec2>,
+    /// Sampled known cells (pixel centres).
+    pub known_samples: Vec<DVec2>,
+    /// Number of known (free or occupied) cells.
+    pub known_cells: usize,
+    /// Share of known cells within the wall tolerance of a wall: what a random placement scores.
+    pub wall_base_rate: f64,
+}
+
+fn strided(points: Vec<DVec2>, max: usize) -> Vec<DVec2> {
+    if points.len() <= max {
+        return points;
+    }
+    let step = points.len() as f64 / max as f64;
+    (0..max)
+        .map(|i| points[(i as f64 * step) as usize])
+        .collect()
+}
+
+impl<'a> PreparedMap<'a> {
+    /// Precompute the nearest-wall transform and the samples of `grid`.
+    pub fn new(grid: &'a OccupancyGrid, config: &VerifyConfig) -> Self {
+        let walls = NearestOccupied::new(grid);
+        let (mut occ, mut known) = (Vec::new(), Vec::new());
+        let mut near = 0usize;
+        for y in 0..grid.height() {
+            for x in 0..grid.width() {
+                let s = grid.state(x, y);
+                if s == CellState::Unknown {
+                    continue;
+                }
+                let p = DVec2::new(x as f64, y as f64);
+                known.push(p);
+                if s == CellState::Occupied {
+                    occ.push(p);
+                }
+                if walls.distance(x, y) <= config.wall_tolerance_px {
+                    near += 1;
+                }
+            }
+        }
+        let known_cells = known.len();
+        let wall_base_rate = if known_cells == 0 {
+            0.0
+        } else {
+            near as f64 / known_cells as f64
+        };
+        Self {
+            grid,
+            walls,
+            wall_samples: strided(occ, config.max_samples),
+            known_samples: strided(known, config.max_samples),
+            known_cells,
+            wall_base_rate,
+        }
+    }
+}
+
+/// The scores of one hypothesis.
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
+pub struct Verification {
+    /// Share of compared wall cells that land near a wall of the other map (both directions).
+    pub wall_agreement: f64,
+    /// `(wall_agreement - base) / (1 - base)`: 0 for a random placement, 1 for perfect.
+    pub wall_lift: f64,
+    /// Wall cells compared, both directions together.
+    pub wall_support: usize,
+    /// Acceptance index over sampled cells known in both maps.
+    pub acceptance_index: f64,
+    /// Estimated number of cells known in both maps.
+    pub overlap_cells: usize,
+    /// `overlap_cells` over the smaller map's known cells.
+    pub overlap_fraction: f64,
+}
+
+impl Verification {
+    /// Whether this hypothesis passes every threshold of `config`.
+    pub fn accepted(&self, config: &VerifyConfig) -> bool {
+        self.wall_lift >= config.min_wall_lift
+            && self.acceptance_index >= config.min_acceptance_index
+            && self.wall_support >= config.min_wall_support
+            && self.overlap_fraction >= config.min_overlap_fraction
+    }
+
+    /// A single number to rank hypotheses by: wall lift weighted by agreement of free space.
+    pub fn score(&self) -> f64 {
+        self.wall_lift * self.acceptance_index
+    }
+}
+
+#[inline]
+fn cell_of(grid: &OccupancyGrid, q: DVec2) -> Option<(usize, usize)> {
+    let (x, y) = (q.x.round(), q.y.round());
+    (x >= 0.0 && y >= 0.0 && (x as usize) < grid.width() && (y as usize) < grid.height())
+        .then_some((x as usize, y as usize))
+}
+
+/// Wall hits and wall cells compared when `from`'s walls are mapped onto `onto` by `t`.
+fn wall_hits(from: &PreparedMap, onto: &PreparedMap, t: &Rigid2, tol: f32) -> (usize, usize) {
+    let (mut hits, mut total) = (0, 0);
+    for &p in &from.wall_samples {
+        if let Some((x, y)) = cell_of(onto.grid, t.apply(p)) {
+            if onto.grid.state(x, y) == CellState::Unknown {
+                continue;
+            }
+            total += 1;
+            if onto.walls.distance(x, y) <= tol {
+                hits += 1;
+            }
+        }
+    }
+    (hits, total)
+}
+
+/// Score hypothesis `b_to_a` (maps pixels of `b` onto `a`).
+pub fn verify(
+    a: &PreparedMap,
+    b: &PreparedMap,
+    b_to_a: &Rigid2,
+    config: &VerifyConfig,
+) -> Verification {
+    let tol = config.wall_tolerance_px;
+    let (h_ba, n_ba) = wall_hits(b, a, b_to_a, tol);
+    let (h_ab, n_ab) = wall_hits(a, b, &b_to_a.inverse(), tol);
+    let wall_support = n_ba + n_ab;
+    let wall_agreement = if wall_support == 0 {
+        0.0
+    } else {
+        (h_ba + h_ab) as f64 / wall_support as f64
+    };
+    // Expected agreement of a random placement, weighted like the observed one.
+    let base = if wall_support == 0 {
+        0.0
+    } else {
+        (a.wall_base_rate * n_ba as f64 + b.wall_base_rate * n_ab as f64) / wall_support as f64
+    };
+    let wall_lift = if base >= 1.0 {
+        0.0
+    } else {
+        (wall_agreement - base) / (1.0 - base)
+    };
+
+    let (mut agree, mut both) = (0usize, 0usize);
+    for &p in &b.known_samples {
+        if let Some((x, y)) = cell_of(a.grid, b_to_a.apply(p)) {
+            let sa = a.grid.state(x, y);
+            if sa == CellState::Unknown {
+                continue;
+            }
+            both += 1;
+            let sb = b.grid.state(p.x as usize, p.y as usize);
+            if sa == sb {
+                agree += 1;
+            }
+        }
+    }
+    let acceptance_index = if both == 0 {
+        0.0
+    } else {
+        agree as f64 / both as f64
+    };
+    let sample_scale = b.known_cells as f64 / b.known_samples.len().max(1) as f64;
+    let overlap_cells = (both as f64 * sample_scale).round() as usize;
+    let smaller = a.known_cells.min(b.known_cells).max(1);
+    Verification {
+        wall_agreement,
+        wall_lift,
+        wall_support,
+        acceptance_index,
+        overlap_cells,
+        overlap_fraction: overlap_cells as f64 / smaller as f64,
+    }
+}
