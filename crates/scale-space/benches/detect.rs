@@ -1,0 +1,2 @@
+//! Criterion bench: pyramid and detection.
+fn main() {}

@@ -1,0 +1,2 @@
+//! Criterion bench: extraction and matching (filled in below).
+fn main() {}

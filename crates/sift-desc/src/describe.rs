@@ -1,0 +1,243 @@
+//! Orientation assignment and the 128-D descriptor (IPOL "Anatomy of SIFT", §4).
+
+use std::f32::consts::TAU;
+
+use scale_space::{Image, Keypoint, ScaleSpace};
+
+/// Orientation histogram bins (IPOL `n_bins`).
+pub const ORIENTATION_BINS: usize = 36;
+/// Spatial histograms per side (IPOL `n_hist`).
+pub const N_HIST: usize = 4;
+/// Orientation bins per spatial histogram (IPOL `n_ori`).
+pub const N_ORI: usize = 8;
+/// Descriptor length: `N_HIST * N_HIST * N_ORI`.
+pub const DESCRIPTOR_LEN: usize = N_HIST * N_HIST * N_ORI;
+
+/// Parameters of orientation assignment and description.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DescriptorConfig {
+    /// Gaussian window of the orientation histogram, in keypoint scales (IPOL `lambda_ori`):
+    /// default 1.5. The patch extends to `3 lambda_ori sigma`.
+    pub lambda_ori: f32,
+    /// Local histogram peaks at least this fraction of the maximum give a keypoint
+    /// (IPOL `t`): default 0.8.
+    pub peak_ratio: f32,
+    /// Circular box smoothings of the orientation histogram: default 6 (IPOL).
+    pub smoothing_passes: usize,
+    /// Half width of the descriptor patch in keypoint scales (IPOL `lambda_descr`): default 6,
+    /// so each of the 4 x 4 spatial histograms covers `3 sigma` on a side.
+    pub lambda_descr: f32,
+    /// Normalised descriptor entries are clamped to this before renormalising: default 0.2.
+    pub clamp: f32,
+}
+
+impl Default for DescriptorConfig {
+    fn default() -> Self {
+        Self {
+            lambda_ori: 1.5,
+            peak_ratio: 0.8,
+            smoothing_passes: 6,
+            lambda_descr: 6.0,
+            clamp: 0.2,
+        }
+    }
+}
+
+/// A keypoint with its orientation and descriptor.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SiftFeature {
+    /// Position and scale in the grid's pixel frame.
+    pub keypoint: Keypoint,
+    /// Orientation in radians, pixel convention (`y` down, positive from `+x` towards `+y`),
+    /// in `[0, 2 pi)`.
+    pub angle: f64,
+    /// Descriptor, unit norm scaled by 512 and saturated to `u8` (Lowe's quantisation).
+    pub descriptor: [u8; DESCRIPTOR_LEN],
+}
+
+/// Central-difference gradient `(gx, gy)` at an interior pixel.
+#[inline]
+fn gradient(img: &Image, x: usize, y: usize) -> (f32, f32) {
+    let w = img.width;
+    let d = &img.data;
+    let i = y * w + x;
+    (0.5 * (d[i + 1] - d[i - 1]), 0.5 * (d[i + w] - d[i - w]))
+}
+
+/// Octave-pixel range `[lo, hi]` of samples within `radius` (input pixels) of `c`, or `None`
+/// if it leaves the interior `1..n - 1` where central differences exist.
+#[inline]
+fn sample_range(c: f32, radius: f32, delta: f32, n: usize) -> Option<(usize, usize)> {
+    let lo = ((c - radius) / delta).ceil();
+    let hi = ((c + radius) / delta).floor();
+    (lo >= 1.0 && hi <= (n as f32) - 2.0 && lo <= hi).then_some((lo as usize, hi as usize))
+}
+
+/// Describe keypoint `kp` (detected in `space`, whose image pixel `(0, 0)` sits at `offset` in
+/// the grid frame): one [`SiftFeature`] per dominant orientation is appended to `out`. Nothing
+/// is appended when a patch does not fit inside the image.
+pub fn describe_keypoint(
+    space: &ScaleSpace,
+    offset: (f64, f64),
+    kp: &Keypoint,
+    config: &DescriptorConfig,
+    out: &mut Vec<SiftFeature>,
+) {
+    let octave = &space.octaves[kp.octave];
+    let img = &octave.gaussians[kp.scale_index];
+    let delta = octave.delta;
+    let (x, y, sigma) = (
+        (kp.x - offset.0) as f32,
+        (kp.y - offset.1) as f32,
+        kp.sigma as f32,
+    );
+    // The descriptor patch is the larger one, so it decides whether the keypoint is kept.
+    let r_descr = std::f32::consts::SQRT_2 * config.lambda_descr * sigma * (N_HIST + 1) as f32
+        / N_HIST as f32;
+    let (Some(dx_range), Some(dy_range)) = (
+        sample_range(x, r_descr, delta, img.width),
+        sample_range(y, r_descr, delta, img.height),
+    ) else {
+        return;
+    };
+    let mut hist = [0f32; ORIENTATION_BINS];
+    orientation_histogram(img, delta, x, y, sigma, config, &mut hist);
+    let max = hist.iter().copied().fold(0.0, f32::max);
+    if max <= 0.0 {
+        return;
+    }
+    let n = ORIENTATION_BINS;
+    for k in 0..n {
+        let (hm, h0, hp) = (hist[(k + n - 1) % n], hist[k], hist[(k + 1) % n]);
+        if h0 > hm && h0 > hp && h0 >= config.peak_ratio * max {
+            let shift = 0.5 * (hm - hp) / (hm - 2.0 * h0 + hp);
+            let theta = ((k as f32 + shift) * TAU / n as f32).rem_euclid(TAU);
+            let descriptor = descriptor(img, delta, x, y, sigma, theta, dx_range, dy_range, config);
+            out.push(SiftFeature {
+                keypoint: *kp,
+                angle: theta as f64,
+                descriptor,
+            });
+        }
+    }
+}
+
+/// The smoothed 36-bin histogram of gradient orientations around `(x, y)` (image frame).
+fn orientation_histogram(
+    img: &Image,
+    delta: f32,
+    x: f32,
+    y: f32,
+    sigma: f32,
+    config: &DescriptorConfig,
+    hist: &mut [f32; ORIENTATION_BINS],
+) {
+    let lambda_sigma = config.lambda_ori * sigma;
+    let radius = 3.0 * lambda_sigma;
+    let (Some((x0, x1)), Some((y0, y1))) = (
+        sample_range(x, radius, delta, img.width),
+        sample_range(y, radius, delta, img.height),
+    ) else {
+        return;
+    };
+    let inv = -1.0 / (2.0 * lambda_sigma * lambda_sigma);
+    let scale = ORIENTATION_BINS as f32 / TAU;
+    for n in y0..=y1 {
+        let dy = n as f32 * delta - y;
+        for m in x0..=x1 {
+            let dx = m as f32 * delta - x;
+            let (gx, gy) = gradient(img, m, n);
+            let mag = (gx * gx + gy * gy).sqrt();
+            if mag == 0.0 {
+                continue;
+            }
+            let angle = gy.atan2(gx).rem_euclid(TAU);
+            let bin = ((angle * scale).round() as usize) % ORIENTATION_BINS;
+            hist[bin] += ((dx * dx + dy * dy) * inv).exp() * mag;
+        }
+    }
+    let mut tmp = [0f32; ORIENTATION_BINS];
+    let n = ORIENTATION_BINS;
+    for _ in 0..config.smoothing_passes {
+        tmp.copy_from_slice(hist);
+        for k in 0..n {
+            hist[k] = (tmp[(k + n - 1) % n] + tmp[k] + tmp[(k + 1) % n]) / 3.0;
+        }
+    }
+}
+
+/// The 4x4x8 descriptor of a keypoint with orientation `theta`, quantised like Lowe's.
+#[allow(clippy::too_many_arguments)]
+fn descriptor(
+    img: &Image,
+    delta: f32,
+    x: f32,
+    y: f32,
+    sigma: f32,
+    theta: f32,
+    (x0, x1): (usize, usize),
+    (y0, y1): (usize, usize),
+    config: &DescriptorConfig,
+) -> [u8; DESCRIPTOR_LEN] {
+    let lambda = config.lambda_descr;
+    let (sin, cos) = theta.sin_cos();
+    let half = lambda * (N_HIST + 1) as f32 / N_HIST as f32;
+    let bin_width = 2.0 * lambda / N_HIST as f32;
+    let inv = -1.0 / (2.0 * lambda * lambda);
+    let ori_scale = N_ORI as f32 / TAU;
+    let mut hist = [0f32; DESCRIPTOR_LEN];
+    for n in y0..=y1 {
+        let dy = n as f32 * delta - y;
+        for m in x0..=x1 {
+            let dx = m as f32 * delta - x;
+            // Coordinates in the keypoint's frame, in units of its scale.
+            let u = (dx * cos + dy * sin) / sigma;
+            let v = (-dx * sin + dy * cos) / sigma;
+            if u.abs() >= half || v.abs() >= half {
+                continue;
+            }
+            let (gx, gy) = gradient(img, m, n);
+            let mag = (gx * gx + gy * gy).sqrt();
+            if mag == 0.0 {
+                continue;
+            }
+            let weight = ((u * u + v * v) * inv).exp() * mag;
+            // Continuous bin coordinates: histogram centres sit at integers 0..N_HIST.
+            let bu = u / bin_width + (N_HIST as f32 - 1.0) / 2.0;
+            let bv = v / bin_width + (N_HIST as f32 - 1.0) / 2.0;
+            let bo = ((gy.atan2(gx) - theta).rem_euclid(TAU) * ori_scale).rem_euclid(N_ORI as f32);
+            let (iu, iv, io) = (bu.floor(), bv.floor(), bo.floor());
+            let (fu, fv, fo) = (bu - iu, bv - iv, bo - io);
+            let (iu, iv, io) = (iu as isize, iv as isize, io as usize % N_ORI);
+            for (du, wu) in [(0isize, 1.0 - fu), (1, fu)] {
+                let i = iu + du;
+                if !(0..N_HIST as isize).contains(&i) {
+                    continue;
+                }
+                for (dv, wv) in [(0isize, 1.0 - fv), (1, fv)] {
+                    let j = iv + dv;
+                    if !(0..N_HIST as isize).contains(&j) {
+                        continue;
+                    }
+                    let base = (j as usize * N_HIST + i as usize) * N_ORI;
+                    let w = weight * wu * wv;
+                    hist[base + io] += w * (1.0 - fo);
+                    hist[base + (io + 1) % N_ORI] += w * fo;
+                }
+            }
+        }
+    }
+    let norm = hist.iter().map(|v| v * v).sum::<f32>().sqrt();
+    let mut out = [0u8; DESCRIPTOR_LEN];
+    if norm <= 0.0 {
+        return out;
+    }
+    for v in &mut hist {
+        *v = (*v / norm).min(config.clamp);
+    }
+    let norm = hist.iter().map(|v| v * v).sum::<f32>().sqrt();
+    for (o, v) in out.iter_mut().zip(&hist) {
+        *o = (512.0 * v / norm).min(255.0) as u8;
+    }
+    out
+}
