@@ -52,4 +52,12 @@ pub enum Error {
         /// What is wrong, in words a user can act on.
         reason: String,
     },
+    /// A map was read fine but holds no free or occupied cell, so there is nothing to register
+    /// or merge. The loader never returns it (an all-unknown map is a valid file); callers that
+    /// need known cells use [`crate::io::require_known_cells`].
+    #[error("{}: the map has no free or occupied cell (every cell is unknown)", path.display())]
+    AllUnknown {
+        /// The map file.
+        path: PathBuf,
+    },
 }

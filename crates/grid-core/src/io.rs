@@ -1,1 +1,0 @@
-//! ROS map_server I/O. Filled in by the I/O work.
