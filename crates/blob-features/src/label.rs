@@ -80,8 +80,11 @@ impl Labeler {
                 height,
             });
         }
-        out_labels.clear();
-        out_labels.resize(n_pix, 0);
+        // Pass 1 writes every pixel, so a reused buffer of the right size needs no clearing.
+        if out_labels.len() != n_pix {
+            out_labels.clear();
+            out_labels.resize(n_pix, 0);
+        }
         if n_pix == 0 {
             return Ok(0);
         }
@@ -180,19 +183,36 @@ impl Labeler {
             }
         }
 
-        // Pass 2: final labels, in parallel over rows.
+        // Pass 2: final labels, in parallel over strips, skipping background words of the mask.
         let parent: &[u32] = parent;
+        let chunk = width * rows_per.max(1);
         out_labels
-            .par_chunks_mut(width * rows_per.max(1))
-            .for_each(|chunk| {
-                for l in chunk.iter_mut() {
-                    if *l != 0 {
-                        *l = parent[*l as usize];
+            .par_chunks_mut(chunk)
+            .zip(mask.par_chunks(chunk))
+            .for_each(|(labels, mask)| {
+                let mut i = 0;
+                while i < labels.len() {
+                    if i + WORD <= labels.len() && is_zero_word(&mask[i..i + WORD]) {
+                        i += WORD;
+                        continue;
                     }
+                    if mask[i] != 0 {
+                        labels[i] = parent[labels[i] as usize];
+                    }
+                    i += 1;
                 }
             });
         Ok(n as usize)
     }
+}
+
+/// Bytes of mask tested at once when skipping background (most of a map is not an obstacle).
+const WORD: usize = 16;
+
+/// Whether the `WORD` bytes of `m` are all zero (one 128-bit load instead of 16 branches).
+#[inline]
+fn is_zero_word(m: &[u8]) -> bool {
+    m.try_into().is_ok_and(|b: [u8; WORD]| u128::from_ne_bytes(b) == 0)
 }
 
 /// Root of `l` in the global table, halving the path on the way.
@@ -272,8 +292,16 @@ fn strip_pass8(mask: &[u8], w: usize, labels: &mut [u32], parent: &mut [u32], ba
         let (done, rest) = labels.split_at_mut(y * w);
         let cur = &mut rest[..w];
         let above: Option<&[u32]> = (y > 0).then(|| &done[(y - 1) * w..]);
-        for x in 0..w {
+        let mut x = 0;
+        while x < w {
+            if x + WORD <= w && is_zero_word(&row[x..x + WORD]) {
+                cur[x..x + WORD].fill(0);
+                x += WORD;
+                continue;
+            }
             if row[x] == 0 {
+                cur[x] = 0;
+                x += 1;
                 continue;
             }
             let west = if x > 0 { cur[x - 1] } else { 0 };
@@ -311,6 +339,7 @@ fn strip_pass8(mask: &[u8], w: usize, labels: &mut [u32], parent: &mut [u32], ba
                 }
             };
             cur[x] = l;
+            x += 1;
         }
     }
     t.next
@@ -327,8 +356,16 @@ fn strip_pass4(mask: &[u8], w: usize, labels: &mut [u32], parent: &mut [u32], ba
         let (done, rest) = labels.split_at_mut(y * w);
         let cur = &mut rest[..w];
         let above: Option<&[u32]> = (y > 0).then(|| &done[(y - 1) * w..]);
-        for x in 0..w {
+        let mut x = 0;
+        while x < w {
+            if x + WORD <= w && is_zero_word(&row[x..x + WORD]) {
+                cur[x..x + WORD].fill(0);
+                x += WORD;
+                continue;
+            }
             if row[x] == 0 {
+                cur[x] = 0;
+                x += 1;
                 continue;
             }
             let west = if x > 0 { cur[x - 1] } else { 0 };
@@ -339,6 +376,7 @@ fn strip_pass4(mask: &[u8], w: usize, labels: &mut [u32], parent: &mut [u32], ba
                 (false, true) => north,
                 (false, false) => t.new_label(),
             };
+            x += 1;
         }
     }
     t.next
