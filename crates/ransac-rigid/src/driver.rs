@@ -10,8 +10,10 @@ use crate::sampler::Sampler;
 /// Loop settings; see [`crate::RansacConfig`] for the defaults.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DriverConfig {
-    /// Hard cap on iterations (non-degenerate samples).
+    /// Hard cap on iterations (non-degenerate samples, each scored over all data).
     pub max_iterations: usize,
+    /// Hard cap on samples drawn, degenerate ones included.
+    pub max_draws: usize,
     /// Iterations always run, whatever the adaptive estimate says.
     pub min_iterations: usize,
     /// Desired probability of having drawn at least one all-inlier sample.
@@ -63,10 +65,6 @@ pub fn required_iterations(p_good: f64, confidence: f64, cap: usize) -> usize {
     }
 }
 
-/// Degenerate draws allowed per iteration before the loop gives up; they cost a few
-/// arithmetic operations each, so the cap only guards against all-degenerate data.
-const DRAWS_PER_ITERATION: usize = 20;
-
 /// Buffers the loop reuses, so an iteration allocates nothing.
 struct Work<M> {
     sample: Vec<usize>,
@@ -80,7 +78,14 @@ struct Work<M> {
 /// Each non-degenerate sample yields 0..n models; a model whose score would enter the top k
 /// is refined on its inliers (up to `refine_iterations` rounds, kept only while the score
 /// improves) and inserted so that the list stays pairwise distinct under
-/// [`Estimator::is_same`]. The iteration count adapts to the best model's inlier share.
+/// [`Estimator::is_same`].
+///
+/// Stopping: the adaptive count is in draws, not iterations. Each draw is all-inlier with
+/// probability [`Sampler::all_inlier_probability`] whether or not the pre-check
+/// ([`Estimator::is_sample_valid`]) later rejects it, so after `required_iterations(p)` draws
+/// an all-inlier sample has been seen with probability `confidence`; the pre-check only saves
+/// the scoring of the rejected ones. At least `min_iterations` scored samples are run (draws
+/// permitting), at most `max_iterations` scored and `max_draws` drawn.
 pub fn run<E, S, C>(
     estimator: &E,
     sampler: &mut S,
@@ -98,7 +103,7 @@ where
     let top_k = config.top_k.max(1);
     let mut top: Vec<Scored<E::Model>> = Vec::with_capacity(top_k + 1);
     let mut mask = vec![false; data.len()];
-    let mut needed = config.max_iterations;
+    let mut needed = config.max_draws;
     let mut work = Work {
         sample: Vec::with_capacity(2),
         models: Vec::with_capacity(2),
@@ -106,11 +111,9 @@ where
         inliers: Vec::with_capacity(data.len()),
     };
     let (mut iterations, mut draws) = (0, 0);
-    let max_draws = config.max_iterations.saturating_mul(DRAWS_PER_ITERATION);
-
     while iterations < config.max_iterations
-        && (iterations < config.min_iterations || iterations < needed)
-        && draws < max_draws
+        && draws < config.max_draws
+        && (iterations < config.min_iterations || draws < needed)
     {
         draws += 1;
         sampler.sample(&mut rng, &mut work.sample);
@@ -139,7 +142,7 @@ where
                     *flag = r <= t2;
                 }
                 let p = sampler.all_inlier_probability(&mask);
-                needed = required_iterations(p, config.confidence, config.max_iterations);
+                needed = required_iterations(p, config.confidence, config.max_draws);
             }
         }
     }
@@ -195,8 +198,14 @@ fn local_optimise<E: Estimator, C: Consensus>(
             break;
         };
         let (s, c) = evaluate(estimator, consensus, data, weights, &refined, work);
-        if s > score {
+        // `>=`: an inlier count often ties after the refit, and the least-squares model on
+        // the same inliers is the better one.
+        if s >= score {
+            let converged = s == score && c == count;
             (model, score, count) = (refined, s, c);
+            if converged {
+                break;
+            }
         } else {
             break;
         }

@@ -133,9 +133,20 @@ impl Estimator for RigidEstimator {
                 let db = p.b.distance(q.b);
                 // Rigid transforms preserve distances: a pair whose lengths disagree by more
                 // than the inlier threshold cannot be two inliers.
-                da >= self.config.min_pair_distance_px
-                    && db >= self.config.min_pair_distance_px
-                    && (da - db).abs() <= self.config.threshold_px
+                if da < self.config.min_pair_distance_px
+                    || db < self.config.min_pair_distance_px
+                    || (da - db).abs() > self.config.threshold_px
+                {
+                    return false;
+                }
+                // Orientation pruning here rather than in `estimate`, so that a pruned sample
+                // does not use up one of the iterations.
+                if self.config.orientation_prune_rad.is_some() {
+                    let (va, vb) = (q.a - p.a, q.b - p.b);
+                    let theta = va.y.atan2(va.x) - vb.y.atan2(vb.x);
+                    return !self.pruned_by_orientation(theta, [p, q]);
+                }
+                true
             }
             _ => false,
         }
@@ -324,8 +335,11 @@ mod tests {
                 corr(truth.apply(b1), b1, o1, EvidenceKind::Intensity),
                 corr(truth.apply(b2), b2, o2, EvidenceKind::Intensity),
             ];
+            let est = RigidEstimator::new(c, &data);
             let mut out = Vec::new();
-            RigidEstimator::new(c, &data).estimate(&data, &[0, 1], &mut out);
+            est.estimate(&data, &[0, 1], &mut out);
+            // The pre-check prunes exactly what `estimate` prunes.
+            assert_eq!(est.is_sample_valid(&data, &[0, 1]), out.len() == 1);
             out.len()
         };
         assert_eq!(run(None, None), 1);

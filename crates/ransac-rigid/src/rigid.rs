@@ -1,12 +1,10 @@
 //! The public entry point: configuration, result, and [`estimate_rigid`].
 
 use grid_core::{Correspondence, EvidenceKind, Rigid2};
-use rand::SeedableRng;
-use rand_chacha::ChaCha8Rng;
 
 use crate::RansacError;
 use crate::confidence::{
-    chance_inlier_rate, confidence_from_log10_nfa, distinct_a_pixels, hypothesis_count, log10_nfa,
+    ChanceGrid, confidence_from_log10_nfa, distinct_a_pixels, hypothesis_count, log10_nfa,
 };
 use crate::consensus::{Consensus, InlierCount, Msac};
 use crate::driver::{self, DriverConfig};
@@ -58,9 +56,9 @@ pub struct RansacConfig {
     /// ... and moving the centre of B's points less than this apart (pixels) are one
     /// hypothesis in the top-k list. Default 5.0.
     pub distinct_shift_px: f64,
-    /// Shuffled pairs drawn to measure the chance inlier rate of the confidence. Default
-    /// 20 000.
-    pub chance_pairs: usize,
+    /// Cap on samples drawn, degenerate ones included; the adaptive count is in draws, since
+    /// the cheap pre-checks reject most outlier pairs without scoring them. Default 50 000.
+    pub max_draws: usize,
 }
 
 impl Default for RansacConfig {
@@ -79,7 +77,7 @@ impl Default for RansacConfig {
             orientation_prune_deg: None,
             distinct_angle_deg: 2.0,
             distinct_shift_px: 5.0,
-            chance_pairs: 20_000,
+            max_draws: 50_000,
         }
     }
 }
@@ -95,8 +93,8 @@ impl RansacConfig {
         if !(self.threshold_px.is_finite() && self.threshold_px > 0.0) {
             return bad("threshold_px must be finite and positive");
         }
-        if self.max_iterations == 0 {
-            return bad("max_iterations must be at least 1");
+        if self.max_iterations == 0 || self.max_draws == 0 {
+            return bad("max_iterations and max_draws must be at least 1");
         }
         if !(self.confidence > 0.0 && self.confidence < 1.0) {
             return bad("confidence must be in (0, 1)");
@@ -216,6 +214,7 @@ pub fn estimate_rigid(
     let mut sampler = HybridSampler::new(data.len(), seeds);
     let dc = DriverConfig {
         max_iterations: config.max_iterations,
+        max_draws: config.max_draws,
         min_iterations: config.min_iterations,
         confidence: config.confidence,
         top_k: config.top_k,
@@ -242,8 +241,7 @@ pub fn estimate_rigid(
         return Err(RansacError::NoHypothesis { draws: out.draws });
     }
 
-    // Confidence: independent stream so changing `chance_pairs` never changes the model.
-    let mut rng = ChaCha8Rng::seed_from_u64(config.seed ^ 0x9E37_79B9_7F4A_7C15);
+    let chance = ChanceGrid::new(&data, config.threshold_px);
     let mut pix = Vec::with_capacity(data.len());
     let n_distinct = distinct_a_pixels(&data, &mut pix);
     let n_tests = hypothesis_count(n_distinct, n_seeds);
@@ -262,13 +260,7 @@ pub fn estimate_rigid(
             })
             .collect();
         let k = distinct_a_pixels(inl.iter().map(|&i| &data[i]), &mut pix);
-        let p0 = chance_inlier_rate(
-            &data,
-            &model,
-            config.threshold_px,
-            config.chance_pairs,
-            &mut rng,
-        );
+        let p0 = chance.chance_inlier_rate(&data, &model);
         let l = log10_nfa(n_distinct, k, p0, n_tests);
         hypotheses.push(Hypothesis {
             model,

@@ -164,6 +164,7 @@ fn one_point_area_hypotheses_alone_recover_and_resolve_the_axis_ambiguity() {
     assert_eq!(sampler.single_point_share(), 1.0);
     let dc = driver::DriverConfig {
         max_iterations: 200,
+        max_draws: 10_000,
         min_iterations: 50,
         confidence: 0.999,
         top_k: 5,
