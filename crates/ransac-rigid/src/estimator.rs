@@ -129,10 +129,17 @@ impl Estimator for RigidEstimator {
             [i] => self.config.single_point && is_single_point_seed(&data[i]),
             [i, j] => {
                 let (p, q) = (&data[i], &data[j]);
-                let da = p.a.distance(q.a);
-                let db = p.b.distance(q.b);
+                let (da2, db2) = (p.a.distance_squared(q.a), p.b.distance_squared(q.b));
                 // Rigid transforms preserve distances: a pair whose lengths disagree by more
-                // than the inlier threshold cannot be two inliers.
+                // than the inlier threshold cannot be two inliers. Most random pairs fail the
+                // necessary condition |da² - db²| = |da - db| (da + db) <= 2 t max(da, db)
+                // already, without the square roots this draw-bound loop would wait on.
+                let t = self.config.threshold_px;
+                let diff = da2 - db2;
+                if diff * diff > 4.0 * t * t * da2.max(db2) {
+                    return false;
+                }
+                let (da, db) = (da2.sqrt(), db2.sqrt());
                 if da < self.config.min_pair_distance_px
                     || db < self.config.min_pair_distance_px
                     || (da - db).abs() > self.config.threshold_px

@@ -57,7 +57,7 @@ pub struct RansacConfig {
     /// hypothesis in the top-k list. Default 5.0.
     pub distinct_shift_px: f64,
     /// Cap on samples drawn, degenerate ones included; the adaptive count is in draws, since
-    /// the cheap pre-checks reject most outlier pairs without scoring them. Default 50 000.
+    /// the cheap pre-checks reject most outlier pairs without scoring them. Default 200 000.
     pub max_draws: usize,
 }
 
@@ -77,7 +77,7 @@ impl Default for RansacConfig {
             orientation_prune_deg: None,
             distinct_angle_deg: 2.0,
             distinct_shift_px: 5.0,
-            max_draws: 50_000,
+            max_draws: 200_000,
         }
     }
 }

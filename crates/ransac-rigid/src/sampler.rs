@@ -13,10 +13,15 @@ pub trait Sampler {
     fn all_inlier_probability(&self, inliers: &[bool]) -> f64;
 }
 
-/// Two distinct indices below `n` (`n >= 2`), uniformly.
+/// Two distinct indices below `n` (`n >= 2`), uniformly up to a bias below `n / 2^32`.
+///
+/// One 64-bit draw split in two 32-bit halves, each scaled by a widening multiply (Lemire
+/// without the rejection step): the draw loop is the hot path when inliers are rare.
 fn two_distinct<R: Rng + ?Sized>(rng: &mut R, n: usize) -> (usize, usize) {
-    let i = rng.random_range(0..n);
-    let mut j = rng.random_range(0..n - 1);
+    let r = rng.next_u64();
+    let scale = |half: u64, m: usize| ((u128::from(half) * m as u128) >> 32) as usize;
+    let i = scale(r >> 32, n);
+    let mut j = scale(r & 0xFFFF_FFFF, n - 1);
     if j >= i {
         j += 1;
     }
