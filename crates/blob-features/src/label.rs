@@ -212,7 +212,8 @@ const WORD: usize = 16;
 /// Whether the `WORD` bytes of `m` are all zero (one 128-bit load instead of 16 branches).
 #[inline]
 fn is_zero_word(m: &[u8]) -> bool {
-    m.try_into().is_ok_and(|b: [u8; WORD]| u128::from_ne_bytes(b) == 0)
+    m.try_into()
+        .is_ok_and(|b: [u8; WORD]| u128::from_ne_bytes(b) == 0)
 }
 
 /// Root of `l` in the global table, halving the path on the way.

@@ -8,7 +8,7 @@
 //! [`grid_core::Correspondence`]s with `kind: EvidenceKind::Area` and an orientation of period
 //! pi; it is not a robust estimator (that is `ransac-rigid`'s job) and it does not read map files.
 //!
-//! Pipeline: [`obstacle_mask`] (+ optional [`close`]) → [`Labeler::label`] → per-component
+//! Pipeline: [`not_free_mask`] or [`obstacle_mask`] (+ optional [`close`]) → [`Labeler::label`] → per-component
 //! [`Shape`] → [`Blob`] (orientation, reliability, rotation-invariant descriptor) →
 //! [`match_blobs`]. [`Blobs`] implements [`grid_core::FeatureExtractor`] and
 //! [`BlobCorrespondences`] implements [`grid_core::CorrespondenceSource`]; to match one map
@@ -23,9 +23,9 @@ mod moments;
 
 pub use error::{BlobError, Result};
 pub use extract::{
-    Blob, BlobConfig, BlobScratch, Blobs, DESCRIPTOR_LEN, DescriptorKind, UnknownPolicy,
+    Blob, BlobConfig, BlobScratch, Blobs, DESCRIPTOR_LEN, DescriptorKind, MaskKind, UnknownPolicy,
 };
 pub use label::{Connectivity, Labeler};
-pub use mask::{close, obstacle_mask};
+pub use mask::{close, not_free_mask, obstacle_mask};
 pub use matching::{BlobCorrespondences, MatchConfig, match_blobs};
 pub use moments::{BoundingBox, Shape};

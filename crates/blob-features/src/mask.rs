@@ -14,6 +14,21 @@ pub fn obstacle_mask(grid: &OccupancyGrid, out: &mut Vec<u8>) {
     );
 }
 
+/// Write the "not free" mask of `grid` into `out` (cleared first): `1` where
+/// [`OccupancyGrid::state`] is occupied or unknown, `0` where free.
+///
+/// In a partial map an obstacle is mostly its visible surface (thin, noisy and different for each
+/// robot) around an unknown interior; the not-free island enclosed by free space is the
+/// obstacle's whole footprint, which two robots that both drove around it agree on.
+pub fn not_free_mask(grid: &OccupancyGrid, out: &mut Vec<u8>) {
+    out.clear();
+    out.extend(
+        grid.cells()
+            .iter()
+            .map(|&c| u8::from(OccupancyGrid::classify(c) != CellState::Free)),
+    );
+}
+
 /// Morphological closing (dilation then erosion) of a `0`/`1` mask by a `(2r+1) x (2r+1)` square,
 /// in place; `scratch` is a caller-owned buffer. `radius == 0` leaves the mask unchanged.
 ///
