@@ -1,1 +1,51 @@
-fn main() {}
+//! The `mapmerge` command line: one module per subcommand under `cmd/`, one small function
+//! mapping errors to the exit codes of the conventions (0 ok, 2 bad usage or input, 1 internal
+//! error), and no panic or stack trace reaching the user.
+
+mod cmd;
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+const AFTER_HELP: &str = "\
+Examples:
+  mapmerge info fixtures/maps/wpi_ilab/wpi_ilab.yaml
+  mapmerge info --json maps/robot1.yaml
+  mapmerge info scan.pgm --resolution 0.1 --negate
+
+MAP is a ROS map_server YAML (.yaml/.yml, naming a PGM or PNG image beside it) or a bare
+image (.pgm/.pnm/.png). A bare image is read as a trinary map with resolution 0.05 m/cell,
+origin [0, 0, 0], occupied_thresh 0.65 and free_thresh 0.196 unless the flags above say
+otherwise; those flags do not change maps given by YAML.
+
+Exit codes: 0 success, 2 bad usage or bad input (one line on stderr naming the file and the
+problem), 1 internal error.";
+
+/// Merge the occupancy grid maps of a robot team without knowing where each robot started.
+#[derive(Debug, Parser)]
+#[command(name = "mapmerge", version, about, after_help = AFTER_HELP)]
+struct Cli {
+    #[command(flatten)]
+    bare: cmd::BareImageArgs,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Print a map's size, resolution, origin and counts of free, occupied and unknown cells.
+    Info(cmd::info::InfoArgs),
+}
+
+fn main() -> ExitCode {
+    cmd::run_main(|| {
+        let cli = match Cli::try_parse() {
+            Ok(cli) => cli,
+            Err(e) => return cmd::clap_outcome(e),
+        };
+        match &cli.command {
+            Command::Info(args) => cmd::info::run(args, &cli.bare),
+        }
+    })
+}

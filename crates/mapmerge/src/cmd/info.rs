@@ -1,0 +1,121 @@
+//! `mapmerge info MAP [--json]`: what a map holds.
+
+use std::io::Write;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::Context;
+use clap::Args;
+use serde::Serialize;
+
+use super::{BareImageArgs, load};
+
+const JSON_KEYS: &str = "\
+With --json, prints one JSON object with the keys:
+  path             the MAP argument
+  image            the image file read
+  mode             trinary, scale or raw
+  width, height    size in cells
+  resolution       metres per cell
+  origin           [x, y, yaw]: metres and radians (counter-clockwise), the pose of the
+                   lower-left corner of the lower-left cell (ROS convention)
+  negate           true if dark pixels are free
+  occupied_thresh, free_thresh   the thresholds the image was read with
+  free, occupied, unknown        cell counts (cells between the thresholds are unknown)";
+
+/// Arguments of `mapmerge info`.
+#[derive(Debug, Clone, Args)]
+#[command(after_help = JSON_KEYS)]
+pub struct InfoArgs {
+    /// The map: a map_server YAML or a bare .pgm/.png image
+    #[arg(value_name = "MAP")]
+    pub map: PathBuf,
+    /// Print one JSON object instead of text
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Debug, Serialize)]
+struct Info {
+    path: String,
+    image: String,
+    mode: &'static str,
+    width: usize,
+    height: usize,
+    resolution: f64,
+    origin: [f64; 3],
+    negate: bool,
+    occupied_thresh: f64,
+    free_thresh: f64,
+    free: usize,
+    occupied: usize,
+    unknown: usize,
+}
+
+/// Run `mapmerge info`.
+pub fn run(args: &InfoArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode> {
+    let map = load(&args.map, bare)?;
+    let g = &map.grid;
+    let counts = g.counts();
+    let o = g.origin();
+    let info = Info {
+        path: args.map.display().to_string(),
+        image: map.image_path.display().to_string(),
+        mode: map.metadata.mode.as_str(),
+        width: g.width(),
+        height: g.height(),
+        resolution: g.resolution(),
+        origin: [o.x, o.y, o.yaw],
+        negate: map.metadata.negate,
+        occupied_thresh: map.metadata.occupied_thresh,
+        free_thresh: map.metadata.free_thresh,
+        free: counts.free,
+        occupied: counts.occupied,
+        unknown: counts.unknown,
+    };
+    let text = if args.json {
+        serde_json::to_string(&info).context("cannot encode the JSON output")? + "\n"
+    } else {
+        human(&info)
+    };
+    std::io::stdout()
+        .lock()
+        .write_all(text.as_bytes())
+        .context("cannot write to standard output")?;
+    Ok(ExitCode::SUCCESS)
+}
+
+fn human(i: &Info) -> String {
+    let total = (i.width * i.height) as f64;
+    let pct = |n: usize| 100.0 * n as f64 / total;
+    format!(
+        "map:        {path}\n\
+         image:      {image} (mode {mode}, negate {negate}, occupied_thresh {occ}, free_thresh {free_t})\n\
+         size:       {w} x {h} cells ({wm:.2} x {hm:.2} m)\n\
+         resolution: {r} m/cell\n\
+         origin:     x {ox} m, y {oy} m, yaw {oyaw} rad\n\
+         free:       {free} ({free_p:.1}%)\n\
+         occupied:   {occupied} ({occ_p:.1}%)\n\
+         unknown:    {unknown} ({unk_p:.1}%)\n",
+        path = i.path,
+        image = i.image,
+        mode = i.mode,
+        negate = u8::from(i.negate),
+        occ = i.occupied_thresh,
+        free_t = i.free_thresh,
+        w = i.width,
+        h = i.height,
+        wm = i.width as f64 * i.resolution,
+        hm = i.height as f64 * i.resolution,
+        r = i.resolution,
+        ox = i.origin[0],
+        oy = i.origin[1],
+        oyaw = i.origin[2],
+        free = i.free,
+        free_p = pct(i.free),
+        occupied = i.occupied,
+        occ_p = pct(i.occupied),
+        unknown = i.unknown,
+        unk_p = pct(i.unknown),
+    )
+}

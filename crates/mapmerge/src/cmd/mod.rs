@@ -1,0 +1,242 @@
+//! The subcommands (one module each, `run(args, ...) -> anyhow::Result<ExitCode>`) and what
+//! they share: the bare-image flags and the mapping from errors to exit codes.
+//!
+//! A subcommand returns `Ok(code)` for the outcomes it decides itself (0, or 3 "no trustworthy
+//! match" for the registration commands) and `Err` for everything else; [`run_main`] prints an
+//! `Err` as one line and picks its exit code with [`exit_code_for`].
+
+pub mod info;
+
+use std::process::ExitCode;
+
+use anyhow::Context;
+use clap::Args;
+use grid_core::Pose2;
+use grid_core::io::{BareImageDefaults, LoadOptions, LoadedMap};
+
+/// Exit code: success.
+pub const EXIT_OK: u8 = 0;
+/// Exit code: internal error (a bug, or an environment problem that is not the input's fault).
+pub const EXIT_INTERNAL: u8 = 1;
+/// Exit code: bad usage or bad input.
+pub const EXIT_BAD_INPUT: u8 = 2;
+
+/// Bad usage found by the program itself (clap's own errors included): exit code 2.
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct UsageError(pub String);
+
+/// The exit code for `err`: 2 when the input or the usage is wrong, 1 otherwise.
+///
+/// Every cause in the chain is looked at, so `.context(...)` does not change the code.
+pub fn exit_code_for(err: &anyhow::Error) -> u8 {
+    for cause in err.chain() {
+        if cause.is::<UsageError>() {
+            return EXIT_BAD_INPUT;
+        }
+        if let Some(e) = cause.downcast_ref::<grid_core::Error>() {
+            return match e {
+                // Files that cannot be read or do not hold a usable map: the user's input.
+                grid_core::Error::Io { .. }
+                | grid_core::Error::Format { .. }
+                | grid_core::Error::AllUnknown { .. }
+                | grid_core::Error::ZeroSize { .. }
+                | grid_core::Error::Resolution(_) => EXIT_BAD_INPUT,
+                // Inconsistent buffers can only come from our own code.
+                _ => EXIT_INTERNAL,
+            };
+        }
+    }
+    EXIT_INTERNAL
+}
+
+/// Run the program body, print an error as one line `mapmerge: error: ...` on stderr and
+/// return the exit code. A panic (a bug) is reported in one line too, with exit code 1.
+pub fn run_main(body: impl FnOnce() -> anyhow::Result<ExitCode>) -> ExitCode {
+    std::panic::set_hook(Box::new(|info| {
+        eprintln!("mapmerge: internal error (this is a bug, please report it): {info}");
+    }));
+    match std::panic::catch_unwind(std::panic::AssertUnwindSafe(body)) {
+        Ok(Ok(code)) => code,
+        Ok(Err(err)) => {
+            eprintln!("mapmerge: error: {}", one_line(&message(&err)));
+            ExitCode::from(exit_code_for(&err))
+        }
+        Err(_) => ExitCode::from(EXIT_INTERNAL),
+    }
+}
+
+/// What to do with a clap error: print help or version and succeed, or turn a usage error into
+/// a one-line [`UsageError`] (exit code 2).
+pub fn clap_outcome(e: clap::Error) -> anyhow::Result<ExitCode> {
+    use clap::error::ErrorKind;
+    match e.kind() {
+        ErrorKind::DisplayHelp
+        | ErrorKind::DisplayVersion
+        | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
+            e.print().context("cannot write to the terminal")?;
+            Ok(ExitCode::from(
+                if e.kind() == ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand {
+                    EXIT_BAD_INPUT
+                } else {
+                    EXIT_OK
+                },
+            ))
+        }
+        _ => {
+            // clap renders several lines (message, usage, a hint); keep the message lines.
+            let text = e.render().to_string();
+            let message: Vec<&str> = text
+                .lines()
+                .map(str::trim)
+                .take_while(|l| !l.starts_with("Usage:") && !l.starts_with("For more information"))
+                .filter(|l| !l.is_empty())
+                .collect();
+            let message = message.join(" ");
+            let message = message.strip_prefix("error: ").unwrap_or(&message);
+            Err(UsageError(format!("{message} (see 'mapmerge --help')")).into())
+        }
+    }
+}
+
+/// The error and its causes joined by ": ", skipping a cause whose text is already there
+/// (`grid_core::Error::Io` shows its OS error and also returns it as its source).
+fn message(err: &anyhow::Error) -> String {
+    let mut msg = String::new();
+    for cause in err.chain() {
+        let text = cause.to_string();
+        if !msg.contains(&text) {
+            if !msg.is_empty() {
+                msg.push_str(": ");
+            }
+            msg.push_str(&text);
+        }
+    }
+    msg
+}
+
+/// Collapse a message to one line.
+fn one_line(s: &str) -> String {
+    s.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+/// How to read a map given as a bare image (no YAML). Ignored for YAML maps.
+#[derive(Debug, Clone, Args)]
+pub struct BareImageArgs {
+    /// Metres per cell of a bare image [default: 0.05]
+    #[arg(long, global = true, value_name = "M", value_parser = positive_finite)]
+    pub resolution: Option<f64>,
+    /// A bare image's pixel is occupied when p = (255 - v) / 255 exceeds this [default: 0.65]
+    #[arg(long, global = true, value_name = "P", value_parser = probability)]
+    pub occupied_thresh: Option<f64>,
+    /// A bare image's pixel is free when p is below this [default: 0.196]
+    #[arg(long, global = true, value_name = "P", value_parser = probability)]
+    pub free_thresh: Option<f64>,
+    /// Read a bare image's dark pixels as free (p = v / 255)
+    #[arg(long, global = true)]
+    pub negate: bool,
+}
+
+impl BareImageArgs {
+    /// The load options these flags ask for (a [`UsageError`] if the thresholds contradict).
+    pub fn load_options(&self) -> anyhow::Result<LoadOptions> {
+        let d = BareImageDefaults::default();
+        let bare = BareImageDefaults {
+            resolution: self.resolution.unwrap_or(d.resolution),
+            origin: Pose2::default(),
+            negate: self.negate,
+            occupied_thresh: self.occupied_thresh.unwrap_or(d.occupied_thresh),
+            free_thresh: self.free_thresh.unwrap_or(d.free_thresh),
+            mode: d.mode,
+        };
+        if bare.free_thresh >= bare.occupied_thresh {
+            return Err(UsageError(format!(
+                "the free threshold ({}) must be less than the occupied threshold ({}); \
+                 check --free-thresh and --occupied-thresh",
+                bare.free_thresh, bare.occupied_thresh
+            ))
+            .into());
+        }
+        Ok(LoadOptions {
+            bare_image: bare,
+            ..LoadOptions::default()
+        })
+    }
+}
+
+/// Load a map with the options of `bare`; errors keep their [`grid_core::Error`] for the exit
+/// code.
+pub fn load(path: &std::path::Path, bare: &BareImageArgs) -> anyhow::Result<LoadedMap> {
+    let options = bare.load_options()?;
+    Ok(grid_core::io::load_map_with_metadata(path, &options)?)
+}
+
+fn parse_f64(s: &str) -> Result<f64, String> {
+    s.trim()
+        .parse::<f64>()
+        .map_err(|_| "not a number".to_string())
+}
+
+fn positive_finite(s: &str) -> Result<f64, String> {
+    let v = parse_f64(s)?;
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err("must be a finite number greater than 0".into())
+    }
+}
+
+fn probability(s: &str) -> Result<f64, String> {
+    let v = parse_f64(s)?;
+    if (0.0..=1.0).contains(&v) {
+        Ok(v)
+    } else {
+        Err("must be a number between 0 and 1".into())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::PathBuf;
+
+    #[test]
+    fn exit_codes_follow_the_conventions() {
+        let bad_file = anyhow::Error::from(grid_core::Error::Format {
+            path: PathBuf::from("m.yaml"),
+            reason: "missing key `image`".into(),
+        });
+        assert_eq!(exit_code_for(&bad_file), EXIT_BAD_INPUT);
+        // Context added on top keeps the code and shows up in the message.
+        let wrapped = bad_file.context("reading map A");
+        assert_eq!(exit_code_for(&wrapped), EXIT_BAD_INPUT);
+        assert_eq!(
+            message(&wrapped),
+            "reading map A: m.yaml: missing key `image`"
+        );
+        let unknown = anyhow::Error::from(grid_core::Error::AllUnknown {
+            path: PathBuf::from("b.pgm"),
+        });
+        assert_eq!(exit_code_for(&unknown), EXIT_BAD_INPUT);
+        let usage = anyhow::Error::from(UsageError("two maps are needed".into()));
+        assert_eq!(exit_code_for(&usage), EXIT_BAD_INPUT);
+        let bug = anyhow::Error::from(grid_core::Error::CellCount {
+            got: 3,
+            expected: 4,
+        });
+        assert_eq!(exit_code_for(&bug), EXIT_INTERNAL);
+        assert_eq!(
+            exit_code_for(&anyhow::anyhow!("disk on fire")),
+            EXIT_INTERNAL
+        );
+    }
+
+    #[test]
+    fn io_errors_are_not_repeated() {
+        let e = anyhow::Error::from(grid_core::Error::Io {
+            path: PathBuf::from("x.yaml"),
+            source: std::io::Error::new(std::io::ErrorKind::NotFound, "gone"),
+        });
+        assert_eq!(message(&e), "x.yaml: gone");
+    }
+}
