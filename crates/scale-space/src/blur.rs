@@ -81,8 +81,11 @@ fn horizontal(src: &Image, kernel: &GaussianKernel, dst: &mut Image) {
                 padded.resize(w + 2 * r, 0.0);
                 for (i, out) in out_rows.chunks_exact_mut(w).enumerate() {
                     let row = src.row(chunk * ROWS_PER_TASK + i);
-                    for (j, p) in padded.iter_mut().enumerate() {
-                        *p = row[mirror(j as isize - r as isize, w)];
+                    // Copy the row, then mirror only the 2r border samples.
+                    padded[r..r + w].copy_from_slice(row);
+                    for k in 1..=r {
+                        padded[r - k] = row[mirror(-(k as isize), w)];
+                        padded[r + w - 1 + k] = row[mirror((w - 1 + k) as isize, w)];
                     }
                     // Centre tap, then symmetric pairs: the inner loop over x vectorises.
                     for (x, o) in out.iter_mut().enumerate() {

@@ -55,7 +55,13 @@ impl ScaleSpace {
     }
 }
 
-/// Strict extremum of the 26-neighbourhood with `|w| > threshold`.
+/// Extremum of the 26-neighbourhood with `|w| > threshold`.
+///
+/// Comparisons are strict against neighbours that come after the sample in (scale, row,
+/// column) order and non-strict against those before it. Binary occupancy images produce exact
+/// ties (a symmetric room centred between two samples gives two equal DoG values); fully strict
+/// comparisons would drop such extrema altogether, this keeps exactly one sample of a tied
+/// pair, and the quadratic refinement then moves it half a sample to the true position.
 #[inline]
 fn is_extremum(dogs: &[crate::Image], s: usize, x: usize, y: usize, threshold: f32) -> bool {
     let v = dogs[s].at(x, y);
@@ -63,17 +69,29 @@ fn is_extremum(dogs: &[crate::Image], s: usize, x: usize, y: usize, threshold: f
         return false;
     }
     let w = dogs[s].width;
+    // Cheap rejection first: most samples already fail against a horizontal neighbour.
+    let (l, r) = (dogs[s].data[y * w + x - 1], dogs[s].data[y * w + x + 1]);
+    if !((v >= l && v > r) || (v <= l && v < r)) {
+        return false;
+    }
     let mut is_max = true;
     let mut is_min = true;
-    for (ds, d) in dogs[s - 1..=s + 1].iter().enumerate() {
-        for yy in y - 1..=y + 1 {
+    // Own scale first: it rejects most candidates before the other two are read.
+    for (ds, d) in [(1usize, &dogs[s]), (0, &dogs[s - 1]), (2, &dogs[s + 1])] {
+        for (dy, yy) in (y - 1..=y + 1).enumerate() {
             let row = &d.data[yy * w + x - 1..yy * w + x + 2];
             for (dx, &n) in row.iter().enumerate() {
-                if ds == 1 && yy == y && dx == 1 {
-                    continue;
+                match (ds, dy, dx).cmp(&(1, 1, 1)) {
+                    std::cmp::Ordering::Equal => continue,
+                    std::cmp::Ordering::Less => {
+                        is_max &= v >= n;
+                        is_min &= v <= n;
+                    }
+                    std::cmp::Ordering::Greater => {
+                        is_max &= v > n;
+                        is_min &= v < n;
+                    }
                 }
-                is_max &= v > n;
-                is_min &= v < n;
             }
         }
         if !is_max && !is_min {

@@ -52,11 +52,12 @@ pub struct SiftConfig {
     /// Orientation and descriptor parameters (IPOL defaults).
     pub descriptor: DescriptorConfig,
     /// Keep at most this many keypoints per grid, the largest `|DoG|` responses first, before
-    /// orientation assignment: default 4000, which bounds matching time.
+    /// orientation assignment: default 2000, which bounds matching time (quadratic in the
+    /// feature count) at a negligible loss on the measured maps.
     pub max_keypoints: usize,
     /// Ratio-test threshold (nearest / second-nearest): default 0.65.
     pub ratio: f32,
-    /// Mutual nearest neighbours only: default false.
+    /// Mutual nearest neighbours only: default true.
     pub cross_check: bool,
 }
 
@@ -67,7 +68,7 @@ impl Default for SiftConfig {
             scale_space: ScaleSpaceConfig::default(),
             mapping: IntensityMapping::default(),
             descriptor: DescriptorConfig::default(),
-            max_keypoints: 4000,
+            max_keypoints: 2000,
             ratio: m.ratio,
             cross_check: m.cross_check,
         }

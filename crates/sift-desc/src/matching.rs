@@ -10,8 +10,8 @@ pub struct MatchConfig {
     /// Accept a match when `nearest / second-nearest` (Euclidean) is below this: default 0.65
     /// (the value of the occupancy-grid SIFT paper we reproduce; Lowe used 0.8 on photos).
     pub ratio: f32,
-    /// Keep only mutual nearest neighbours (cross-check): default false — the ratio test already
-    /// removes most ambiguous matches, and RANSAC downstream handles the rest (see measurements).
+    /// Keep only mutual nearest neighbours (cross-check): default true — on noisy map pairs it
+    /// raises the inlier fraction (79.8 % → 83.4 %) for 3 % fewer inliers (see the crate docs).
     pub cross_check: bool,
 }
 
@@ -19,7 +19,7 @@ impl Default for MatchConfig {
     fn default() -> Self {
         Self {
             ratio: 0.65,
-            cross_check: false,
+            cross_check: true,
         }
     }
 }
@@ -39,8 +39,10 @@ pub struct Match {
 
 /// Squared Euclidean distance of two quantised descriptors.
 ///
-/// Four independent accumulators over 32-byte lanes let the compiler keep several vector sums
-/// in flight (widening multiply-add on x86).
+/// Four independent accumulators over 32-byte lanes keep several vector sums in flight. Measured
+/// on the 2048 x 2048 bench (`match_*`): about 0.7x the time of the same loop on f32
+/// descriptors, while a plain iterator sum and an explicit pairwise (`pmaddwd`-shaped) form
+/// were 1.7x and 3x slower than f32 on this target (x86-64 baseline, no AVX2).
 #[inline]
 pub fn distance_sq(a: &[u8; DESCRIPTOR_LEN], b: &[u8; DESCRIPTOR_LEN]) -> u32 {
     let mut acc = [0u32; 4];
@@ -170,7 +172,11 @@ mod tests {
         let a = vec![feature(d0), feature(d1)];
         let b = vec![feature(near0), feature(d1), feature(d1)];
         let mut out = Vec::new();
-        match_features(&a, &b, &MatchConfig::default(), &mut out);
+        let plain = MatchConfig {
+            ratio: 0.65,
+            cross_check: false,
+        };
+        match_features(&a, &b, &plain, &mut out);
         // a0 -> b0 (10 vs ~141: passes); a1 -> b1 or b2 at distance 0 twice: ratio 0/0 fails.
         assert_eq!(out.len(), 1);
         assert_eq!((out[0].a, out[0].b), (0, 0));
@@ -190,7 +196,7 @@ mod tests {
             out.iter().map(|m| (m.a, m.b)).collect::<Vec<_>>(),
             vec![(0, 0)]
         );
-        match_features(&a, &b, &MatchConfig::default(), &mut out);
+        match_features(&a, &b, &plain, &mut out);
         assert_eq!(out.len(), 2);
     }
 }

@@ -9,6 +9,11 @@ use rand_chacha::ChaCha8Rng;
 /// Read a P5 PGM with map_server trinary semantics (`p = (255 - v) / 255`, occupied above
 /// 0.65, free below 0.196, unknown otherwise).
 pub fn read_pgm(path: &std::path::Path) -> OccupancyGrid {
+    read_pgm_with(path, 0.65, 0.196)
+}
+
+/// [`read_pgm`] with the YAML's `occupied_thresh` and `free_thresh`.
+pub fn read_pgm_with(path: &std::path::Path, occupied: f64, free: f64) -> OccupancyGrid {
     let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let mut pos = 0;
     let mut token = || {
@@ -40,9 +45,9 @@ pub fn read_pgm(path: &std::path::Path) -> OccupancyGrid {
         .iter()
         .map(|&v| {
             let p = (255.0 - v as f64) / 255.0;
-            if p > 0.65 {
+            if p > occupied {
                 100
-            } else if p < 0.196 {
+            } else if p < free {
                 0
             } else {
                 UNKNOWN
@@ -132,4 +137,21 @@ pub fn inlier_fraction(
         .filter(|c| (truth.apply(c.b) - c.a).length() <= tol)
         .count();
     (good, c.len())
+}
+
+/// A `side x side` "building" made of mirrored tiles of `g` (so walls continue across tile
+/// borders), for speed measurements on large maps.
+pub fn tiled(g: &OccupancyGrid, side: usize) -> OccupancyGrid {
+    let (w, h) = (g.width(), g.height());
+    let mut cells = vec![UNKNOWN; side * side];
+    for y in 0..side {
+        let (ty, ry) = (y / h, y % h);
+        let sy = if ty % 2 == 0 { ry } else { h - 1 - ry };
+        for x in 0..side {
+            let (tx, rx) = (x / w, x % w);
+            let sx = if tx % 2 == 0 { rx } else { w - 1 - rx };
+            cells[y * side + x] = g.cells()[sy * w + sx];
+        }
+    }
+    OccupancyGrid::from_cells(side, side, g.resolution(), g.origin(), cells).unwrap()
 }
