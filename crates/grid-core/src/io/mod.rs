@@ -11,6 +11,12 @@
 //! - `raw`: `round(v)` in `0..=100` is taken as the percentage, anything else is unknown
 //!   (as nav2 does; `negate` does not apply).
 //!
+//! Two deliberate differences from map_server, both chosen by the project: in `scale` mode
+//! map_server (ROS 1 and nav2) stretches `(p - free_thresh) / (occupied_thresh - free_thresh)`
+//! onto `0..=100`, while we keep `p` itself, since a cell here holds an occupancy probability;
+//! and map_server averages the alpha channel in with R, G, B in `trinary` mode (an opaque
+//! `(205, 205, 205, 255)` pixel then reads as free), while we average R, G, B only.
+//!
 //! Every error names the file it is about and says what is wrong in a user's words, so that a
 //! command-line tool can print it as one line. Nothing is allocated for pixels before the image
 //! header has been checked against [`LoadOptions::max_cells`].
