@@ -376,6 +376,8 @@ fn yaml_that_is_not_a_map_server_file() {
         "{msg}"
     );
     assert!(!msg.contains('\n'), "{msg}");
+    let (_dir, path) = yaml_case(&format!("{GOOD_KEYS}resolution: 0.1\n"));
+    assert_fails(&path, "key `resolution` appears more than once");
     let (_dir, path) = yaml_case("");
     std::fs::write(&path, b"image: \xff\xfe.pgm\n").unwrap();
     assert_fails(&path, "not a text file (invalid UTF-8)");

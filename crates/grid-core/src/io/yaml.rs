@@ -105,6 +105,8 @@ impl MapMetadata {
         // Let `.nan`/`.inf` through so that validation names the key they are in.
         let mut options = serde_saphyr::Options::default();
         options.non_finite_float_policy = serde_saphyr::NonFiniteFloatPolicy::PassThrough;
+        // Duplicates reach our visitor, so that the message names the key in plain words.
+        options.duplicate_keys = serde_saphyr::DuplicateKeyPolicy::PassThrough;
         let value: YamlValue = serde_saphyr::from_str_with_options(text, options).map_err(|e| {
             format_error(
                 path,
@@ -124,7 +126,15 @@ impl MapMetadata {
                 ),
             ));
         };
-        let get = |key: &str| entries.iter().rev().find(|(k, _)| k == key).map(|(_, v)| v);
+        for (i, (key, _)) in entries.iter().enumerate() {
+            if entries[..i].iter().any(|(k, _)| k == key) {
+                return Err(format_error(
+                    path,
+                    format!("key `{key}` appears more than once"),
+                ));
+            }
+        }
+        let get = |key: &str| entries.iter().find(|(k, _)| k == key).map(|(_, v)| v);
         let required = |key: &'static str, what: &str| {
             get(key).ok_or_else(|| format_error(path, format!("missing key `{key}` ({what})")))
         };
