@@ -75,10 +75,11 @@ struct Work<M> {
 
 /// Run RANSAC with local optimisation over `data`.
 ///
-/// Each non-degenerate sample yields 0..n models; a model whose score would enter the top k
-/// is refined on its inliers (up to `refine_iterations` rounds, kept only while the score
-/// improves) and inserted so that the list stays pairwise distinct under
-/// [`Estimator::is_same`].
+/// Each non-degenerate sample yields 0..n models. A model that beats the best so far is
+/// refined on its inliers (up to `refine_iterations` rounds, kept while the score does not
+/// drop); a model that enters the top k is inserted so that the list stays pairwise distinct
+/// under [`Estimator::is_same`]. After the loop every kept hypothesis is refined the same way
+/// and the list rebuilt.
 ///
 /// Stopping: the adaptive count is in draws, not iterations. Each draw is all-inlier with
 /// probability [`Sampler::all_inlier_probability`] whether or not the pre-check
@@ -129,9 +130,21 @@ where
             if !enters {
                 continue;
             }
-            let cand = local_optimise(
-                estimator, consensus, data, &weights, config, m, score, count, &mut work,
-            );
+            // Local optimisation only for a new best (as in LO-RANSAC): near every draw enters
+            // a top-k list of junk early on, and refitting each would cost more than the
+            // search. The other top-k entries are refined once after the loop.
+            let is_best = top.first().is_none_or(|b| score > b.score);
+            let cand = if is_best {
+                local_optimise(
+                    estimator, consensus, data, &weights, config, m, score, count, &mut work,
+                )
+            } else {
+                Scored {
+                    model: m,
+                    score,
+                    inliers: count,
+                }
+            };
             let was_best = top.first().map(|b| b.score);
             insert_distinct(estimator, &mut top, cand, top_k);
             let best = &top[0];
@@ -146,8 +159,18 @@ where
             }
         }
     }
+    // Final polish: refine every kept hypothesis and rebuild the list, since two of them may
+    // converge to one model.
+    let mut polished = Vec::with_capacity(top.len());
+    for h in top {
+        let (score, count) = evaluate(estimator, consensus, data, &weights, &h.model, &mut work);
+        let cand = local_optimise(
+            estimator, consensus, data, &weights, config, h.model, score, count, &mut work,
+        );
+        insert_distinct(estimator, &mut polished, cand, top_k);
+    }
     DriverOutput {
-        hypotheses: top,
+        hypotheses: polished,
         iterations,
         draws,
     }

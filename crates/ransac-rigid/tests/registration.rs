@@ -464,3 +464,73 @@ fn confidence_stays_low_on_random_matches_along_walls() {
     eprintln!("random along walls: {low}/100 below 0.5, max confidence {max_conf}");
     assert!(low >= 95, "{low}/100 random wall sets below 0.5");
 }
+
+fn wild_coord() -> impl Strategy<Value = f64> {
+    prop_oneof![
+        -1e4..1e4f64,
+        Just(0.0),
+        Just(1e15),
+        Just(-1e15),
+        Just(f64::NAN),
+        Just(f64::INFINITY),
+        (-3.0..3.0f64),
+    ]
+}
+
+fn wild_corr() -> impl Strategy<Value = Correspondence> {
+    (
+        wild_coord(),
+        wild_coord(),
+        wild_coord(),
+        wild_coord(),
+        prop::option::of((
+            wild_coord(),
+            wild_coord(),
+            prop_oneof![Just(PI), Just(2.0 * PI), Just(0.0), Just(-1.0)],
+        )),
+        prop_oneof![
+            Just(1.0),
+            Just(0.0),
+            Just(-1.0),
+            Just(f64::NAN),
+            0.01..1.0f64
+        ],
+        prop::bool::ANY,
+    )
+        .prop_map(|(ax, ay, bx, by, o, weight, area)| Correspondence {
+            a: DVec2::new(ax, ay),
+            b: DVec2::new(bx, by),
+            orientation: o.map(|(a, b, period)| Orientation { a, b, period }),
+            weight,
+            kind: if area {
+                EvidenceKind::Area
+            } else {
+                EvidenceKind::Intensity
+            },
+        })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(200))]
+
+    /// Arbitrary input (NaN, infinities, huge values, zero or negative weights and periods)
+    /// never panics, and an answer only refers to usable correspondences.
+    #[test]
+    fn arbitrary_input_never_panics(data in prop::collection::vec(wild_corr(), 0..40), seed in 0u64..100) {
+        let cfg = RansacConfig { seed, max_draws: 5_000, ..Default::default() };
+        match estimate_rigid(&data, &cfg) {
+            Ok(r) => {
+                prop_assert!(r.model.theta.is_finite());
+                prop_assert!((0.0..=1.0).contains(&r.confidence));
+                prop_assert!(!r.hypotheses.is_empty() && r.hypotheses.len() <= 5);
+                for &i in &r.inliers {
+                    let c = &data[i];
+                    prop_assert!(c.a.is_finite() && c.b.is_finite() && c.weight > 0.0);
+                }
+            }
+            Err(RansacError::TooFewCorrespondences { usable, needed: 2 }) => prop_assert!(usable < 2),
+            Err(RansacError::NoHypothesis { .. }) => {}
+            Err(e) => prop_assert!(false, "{e}"),
+        }
+    }
+}
