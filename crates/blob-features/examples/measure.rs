@@ -105,19 +105,21 @@ fn main() {
             .iter()
             .map(|(a, b, t)| (extract(cfg, a), extract(cfg, b), *t))
             .collect();
-        for (ratio, mutual, max_distance) in [
-            (0.7, true, f64::INFINITY),
-            (0.8, true, f64::INFINITY),
-            (0.9, true, f64::INFINITY),
-            (1.0, true, f64::INFINITY),
-            (0.8, false, f64::INFINITY),
-            (0.8, true, 0.3),
-            (0.9, true, 0.3),
+        for (ratio, mutual, max_distance, candidates) in [
+            (0.7, true, f64::INFINITY, 1),
+            (0.8, true, f64::INFINITY, 1),
+            (0.9, true, f64::INFINITY, 1),
+            (1.0, true, f64::INFINITY, 1),
+            (0.8, false, f64::INFINITY, 1),
+            (0.8, true, 0.3, 1),
+            (0.9, true, 0.3, 1),
+            (0.8, true, 0.3, 3),
         ] {
             let m = MatchConfig {
                 ratio,
                 mutual,
                 max_distance,
+                candidates,
             };
             let (mut good, mut total) = (0, 0);
             for (ba, bb, t) in &ex {
@@ -130,7 +132,7 @@ fn main() {
                     .count();
             }
             println!(
-                "{kind:?}{:w$} ratio {ratio:.1} mutual {mutual:5} max_d {max_distance:4.1}: {good:4}/{total:4} = {:.3}  ({:.1} true per pair)",
+                "{kind:?}{:w$} ratio {ratio:.1} mutual {mutual:5} max_d {max_distance:4.1} k {candidates}: {good:4}/{total:4} = {:.3}  ({:.1} true per pair)",
                 "",
                 good as f64 / total.max(1) as f64,
                 good as f64 / ex.len() as f64,

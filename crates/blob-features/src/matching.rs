@@ -15,6 +15,11 @@ pub struct MatchConfig {
     /// Largest descriptor distance accepted at all (log units: 0.3 is about a 30 % size
     /// difference). Default 0.3.
     pub max_distance: f64,
+    /// Candidates per blob of B. `1` (default) keeps the nearest neighbour after the ratio
+    /// test and the mutual check; `k > 1` instead keeps the `k` nearest blobs of A within
+    /// `max_distance` (no ratio test, no mutual check), weighted `1 / (1 + rank)`, for a robust
+    /// estimator that prefers more true matches among more outliers (repetitive scenes).
+    pub candidates: usize,
 }
 
 impl Default for MatchConfig {
@@ -23,6 +28,7 @@ impl Default for MatchConfig {
             ratio: 0.8,
             mutual: true,
             max_distance: 0.3,
+            candidates: 1,
         }
     }
 }
@@ -53,6 +59,9 @@ fn two_nearest(q: &Blob, set: &[Blob]) -> Option<(usize, f64, f64)> {
 ///
 /// Both blob lists must come from the same [`crate::DescriptorKind`].
 pub fn match_blobs(a: &[Blob], b: &[Blob], config: &MatchConfig, out: &mut Vec<Correspondence>) {
+    if config.candidates > 1 {
+        return match_top_k(a, b, config, out);
+    }
     let max_d2 = config.max_distance * config.max_distance;
     let ratio2 = config.ratio * config.ratio;
     for qb in b {
@@ -70,27 +79,53 @@ pub fn match_blobs(a: &[Blob], b: &[Blob], config: &MatchConfig, out: &mut Vec<C
                 continue;
             }
         }
-        let ba = &a[ia];
         let r = if d2.is_finite() && d2 > 0.0 {
             (d1 / d2).sqrt()
         } else {
             0.0
         };
-        let weight = ((1.0 - r) * ba.reliability * qb.reliability).clamp(1e-3, 1.0);
-        out.push(Correspondence {
-            a: ba.shape.centroid,
-            b: qb.shape.centroid,
-            orientation: match (ba.orientation, qb.orientation) {
-                (Some(oa), Some(ob)) => Some(Orientation {
-                    a: oa,
-                    b: ob,
-                    period: std::f64::consts::PI,
-                }),
-                _ => None,
-            },
-            weight,
-            kind: EvidenceKind::Area,
-        });
+        out.push(correspondence(&a[ia], qb, 1.0 - r));
+    }
+}
+
+/// The `k` nearest blobs of A for each blob of B (see [`MatchConfig::candidates`]).
+fn match_top_k(a: &[Blob], b: &[Blob], config: &MatchConfig, out: &mut Vec<Correspondence>) {
+    let max_d2 = config.max_distance * config.max_distance;
+    let k = config.candidates;
+    // (squared distance, index in a), kept sorted; one buffer for the whole call.
+    let mut best: Vec<(f64, usize)> = Vec::with_capacity(k + 1);
+    for qb in b {
+        best.clear();
+        for (i, s) in a.iter().enumerate() {
+            let d = dist2(&qb.descriptor, &s.descriptor);
+            if d > max_d2 || (best.len() == k && d >= best[k - 1].0) {
+                continue;
+            }
+            let at = best.partition_point(|&(e, _)| e <= d);
+            best.insert(at, (d, i));
+            best.truncate(k);
+        }
+        for (rank, &(_, i)) in best.iter().enumerate() {
+            out.push(correspondence(&a[i], qb, 1.0 / (1 + rank) as f64));
+        }
+    }
+}
+
+/// A correspondence from blob `qb` of B to blob `ba` of A with match quality `quality`.
+fn correspondence(ba: &Blob, qb: &Blob, quality: f64) -> Correspondence {
+    Correspondence {
+        a: ba.shape.centroid,
+        b: qb.shape.centroid,
+        orientation: match (ba.orientation, qb.orientation) {
+            (Some(oa), Some(ob)) => Some(Orientation {
+                a: oa,
+                b: ob,
+                period: std::f64::consts::PI,
+            }),
+            _ => None,
+        },
+        weight: (quality * ba.reliability * qb.reliability).clamp(1e-3, 1.0),
+        kind: EvidenceKind::Area,
     }
 }
 

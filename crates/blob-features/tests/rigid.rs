@@ -117,3 +117,55 @@ fn extract_once_match_many_equals_the_source() {
     assert!(!direct.is_empty());
     assert_eq!(direct, reused);
 }
+
+#[test]
+fn top_k_candidates_are_sorted_by_descriptor_distance() {
+    let (a, b, _) = pair(7);
+    let blobs = Blobs::default();
+    let mut scratch = BlobScratch::default();
+    let (mut ba, mut bb) = (Vec::new(), Vec::new());
+    blobs.extract_with(&a, &mut scratch, &mut ba);
+    blobs.extract_with(&b, &mut scratch, &mut bb);
+    let m = blob_features::MatchConfig {
+        candidates: 3,
+        max_distance: f64::INFINITY,
+        ..Default::default()
+    };
+    let mut cs = Vec::new();
+    match_blobs(&ba, &bb[..1], &m, &mut cs);
+    // One blob of B, three candidates of distinct A blobs with weights 1, 1/2, 1/3 (times the
+    // reliabilities, 1 here: islands never touch unknown).
+    assert_eq!(cs.len(), 3);
+    let w: Vec<f64> = cs.iter().map(|c| c.weight).collect();
+    assert_eq!(w, vec![1.0, 0.5, 1.0 / 3.0]);
+    let d = |c: &Correspondence| {
+        let ia = ba.iter().position(|x| x.shape.centroid == c.a).unwrap();
+        ba[ia]
+            .descriptor
+            .iter()
+            .zip(&bb[0].descriptor)
+            .map(|(x, y)| (x - y).powi(2))
+            .sum::<f64>()
+    };
+    assert!(d(&cs[0]) <= d(&cs[1]) && d(&cs[1]) <= d(&cs[2]));
+    // The nearest equals what the k = 1 search would return without its filters.
+    let nearest = ba
+        .iter()
+        .min_by(|x, y| {
+            let dx: f64 = x
+                .descriptor
+                .iter()
+                .zip(&bb[0].descriptor)
+                .map(|(p, q)| (p - q).powi(2))
+                .sum();
+            let dy: f64 = y
+                .descriptor
+                .iter()
+                .zip(&bb[0].descriptor)
+                .map(|(p, q)| (p - q).powi(2))
+                .sum();
+            dx.total_cmp(&dy)
+        })
+        .unwrap();
+    assert_eq!(cs[0].a, nearest.shape.centroid);
+}
