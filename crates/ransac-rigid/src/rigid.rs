@@ -172,6 +172,25 @@ fn usable(c: &Correspondence) -> bool {
 /// correspondences with an orientation (period `pi` gives two candidates); deterministic for
 /// a given `config.seed`. Unusable correspondences (non-finite, weight ≤ 0) are ignored.
 ///
+/// ```
+/// use grid_core::{Correspondence, DVec2, EvidenceKind, Rigid2};
+/// use ransac_rigid::{RansacConfig, estimate_rigid};
+///
+/// let truth = Rigid2::new(0.5, 12.0, -3.0);
+/// let corr = |b: DVec2, a: DVec2| Correspondence {
+///     a, b, orientation: None, weight: 1.0, kind: EvidenceKind::Intensity,
+/// };
+/// let mut data: Vec<_> = (0..12)
+///     .map(|i| DVec2::new((i * 37 % 100) as f64, (i * 61 % 90) as f64))
+///     .map(|b| corr(b, truth.apply(b)))
+///     .collect();
+/// data.push(corr(DVec2::new(5.0, 5.0), DVec2::new(80.0, 1.0))); // an outlier
+/// let r = estimate_rigid(&data, &RansacConfig::default()).unwrap();
+/// assert!((r.model.theta - 0.5).abs() < 1e-9);
+/// assert_eq!(r.inliers, (0..12).collect::<Vec<_>>());
+/// assert!(r.confidence > 0.99);
+/// ```
+///
 /// # Errors
 /// [`RansacError::TooFewCorrespondences`] below 2 usable correspondences,
 /// [`RansacError::NoHypothesis`] when every sample is degenerate (e.g. all points within
