@@ -42,7 +42,118 @@ fn extract(cfg: BlobConfig, g: &OccupancyGrid) -> Vec<Blob> {
     out
 }
 
+/// A P5 PGM map_server image read as trinary (tests only: 0 occupied, >= 250 free, else
+/// unknown), `None` when absent or not P5.
+fn read_pgm(path: &str) -> Option<OccupancyGrid> {
+    let bytes = std::fs::read(path).ok()?;
+    let mut fields = Vec::new();
+    let mut i = 0;
+    while fields.len() < 4 {
+        while bytes.get(i)?.is_ascii_whitespace() {
+            i += 1;
+        }
+        if bytes[i] == b'#' {
+            while bytes[i] != b'\n' {
+                i += 1;
+            }
+            continue;
+        }
+        let start = i;
+        while !bytes.get(i)?.is_ascii_whitespace() {
+            i += 1;
+        }
+        fields.push(String::from_utf8_lossy(&bytes[start..i]).to_string());
+    }
+    let (w, h): (usize, usize) = (fields[1].parse().ok()?, fields[2].parse().ok()?);
+    if fields[0] != "P5" || fields[3] != "255" {
+        return None;
+    }
+    let px = bytes.get(i + 1..i + 1 + w * h)?;
+    let cells = px
+        .iter()
+        .map(|&v| match v {
+            0 => 100,
+            v if v >= 250 => 0,
+            _ => grid_core::UNKNOWN,
+        })
+        .collect();
+    OccupancyGrid::from_cells(w, h, 0.05, Default::default(), cells).ok()
+}
+
+/// Real maps: each placed on a canvas large enough to turn it, then warped by 5 random rigid
+/// transforms; matches within 2 px of the truth. Skipped when /work/shared/maps is absent.
+fn real_maps() {
+    println!(
+        "\n== real maps (/work/shared/maps), map vs. its rigidly warped copy, 5 transforms each"
+    );
+    for name in [
+        "wpi_ilab",
+        "tb3_world",
+        "aws_small_house",
+        "nav2_depot",
+        "sunil_pair_a",
+    ] {
+        let Some(map) = read_pgm(&format!("/work/shared/maps/{name}/{name}.pgm")) else {
+            println!("{name}: not available");
+            continue;
+        };
+        let side = (map.width() as f64).hypot(map.height() as f64).ceil() as usize + 40;
+        let off = Rigid2::new(
+            0.0,
+            ((side - map.width()) / 2) as f64,
+            ((side - map.height()) / 2) as f64,
+        );
+        let a = map.warp(&off, side, side).unwrap();
+        for mask in [
+            blob_features::MaskKind::Occupied,
+            blob_features::MaskKind::NotFreeIslands,
+        ] {
+            let cfg = BlobConfig {
+                mask,
+                ..BlobConfig::default()
+            };
+            let ba = extract(cfg, &a);
+            let (mut good, mut total, mut o_ok, mut with_o) = (0, 0, 0, 0);
+            for seed in 0..5u64 {
+                let mut rng = ChaCha8Rng::seed_from_u64(seed);
+                let theta = rng.random_range(-PI..PI);
+                let c = DVec2::splat(side as f64 / 2.0);
+                let rc = Rigid2::new(theta, 0.0, 0.0).apply(c);
+                let truth = Rigid2::new(
+                    theta,
+                    c.x - rc.x + rng.random_range(-10.0..10.0),
+                    c.y - rc.y + rng.random_range(-10.0..10.0),
+                );
+                let b = a.warp(&truth.inverse(), side, side).unwrap();
+                let bb = extract(cfg, &b);
+                let mut cs = Vec::new();
+                match_blobs(&ba, &bb, &MatchConfig::default(), &mut cs);
+                total += cs.len();
+                for c in &cs {
+                    if (truth.apply(c.b) - c.a).length() < 2.0 {
+                        good += 1;
+                        if let Some(o) = c.orientation {
+                            with_o += 1;
+                            if axis_err_deg(o.a - o.b - truth.theta) < 5.0 {
+                                o_ok += 1;
+                            }
+                        }
+                    }
+                }
+            }
+            println!(
+                "{name:16} {mask:?}{:w$} blobs {:4}  matches {total:4}  within 2 px {good:4} ({:.3})  orientation within 5 deg {o_ok}/{with_o}",
+                "",
+                ba.len(),
+                good as f64 / total.max(1) as f64,
+                w = 15 - format!("{mask:?}").len()
+            );
+        }
+    }
+}
+
 fn main() {
+    real_maps();
     let seeds = 0..20u64;
     let pairs: Vec<_> = seeds.map(pair).collect();
 
