@@ -74,31 +74,45 @@ fn is_extremum(dogs: &[crate::Image], s: usize, x: usize, y: usize, threshold: f
     if !((v >= l && v > r) || (v <= l && v < r)) {
         return false;
     }
-    let mut is_max = true;
-    let mut is_min = true;
     // Own scale first: it rejects most candidates before the other two are read.
-    for (ds, d) in [(1usize, &dogs[s]), (0, &dogs[s - 1]), (2, &dogs[s + 1])] {
-        for (dy, yy) in (y - 1..=y + 1).enumerate() {
-            let row = &d.data[yy * w + x - 1..yy * w + x + 2];
-            for (dx, &n) in row.iter().enumerate() {
-                match (ds, dy, dx).cmp(&(1, 1, 1)) {
-                    std::cmp::Ordering::Equal => continue,
-                    std::cmp::Ordering::Less => {
-                        is_max &= v >= n;
-                        is_min &= v <= n;
-                    }
-                    std::cmp::Ordering::Greater => {
-                        is_max &= v > n;
-                        is_min &= v < n;
-                    }
-                }
+    let cur = &dogs[s].data;
+    let (up, down) = ((y - 1) * w + x - 1, (y + 1) * w + x - 1);
+    let (mut before_max, mut before_min) = (l, l);
+    let (mut after_max, mut after_min) = (r, r);
+    for &n in &cur[up..up + 3] {
+        before_max = before_max.max(n);
+        before_min = before_min.min(n);
+    }
+    for &n in &cur[down..down + 3] {
+        after_max = after_max.max(n);
+        after_min = after_min.min(n);
+    }
+    let mut is_max = v >= before_max && v > after_max;
+    let mut is_min = v <= before_min && v < after_min;
+    if !is_max && !is_min {
+        return false;
+    }
+    // Scale s - 1 comes before the sample, scale s + 1 after it.
+    for (d, before) in [(&dogs[s - 1].data, true), (&dogs[s + 1].data, false)] {
+        let (mut hi, mut lo) = (f32::MIN, f32::MAX);
+        for row in [up, up + w, down] {
+            for &n in &d[row..row + 3] {
+                hi = hi.max(n);
+                lo = lo.min(n);
             }
+        }
+        if before {
+            is_max &= v >= hi;
+            is_min &= v <= lo;
+        } else {
+            is_max &= v > hi;
+            is_min &= v < lo;
         }
         if !is_max && !is_min {
             return false;
         }
     }
-    is_max || is_min
+    true
 }
 
 /// A refined extremum: discrete position, sub-sample offset `(ds, dx, dy)`, interpolated value.

@@ -11,8 +11,8 @@
 //!
 //! # Defaults and why
 //!
-//! See `MEASUREMENTS` in the `sift-desc` crate docs for the inlier-fraction tables that chose
-//! the [`IntensityMapping`] default (unknown = occupied value), the first-octave sampling and
+//! See "Measurements that chose the defaults" in the `sift-desc` crate docs for the tables
+//! that chose the [`IntensityMapping`] default (unknown = occupied value), the first-octave sampling and
 //! the crop; the scale-space constants are the IPOL ones unless stated on the field.
 
 mod blur;

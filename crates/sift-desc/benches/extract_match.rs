@@ -74,7 +74,18 @@ fn bench(c: &mut Criterion) {
         bench.iter(|| black_box(sift.extract_features(black_box(&a))).len())
     });
     let mut out = Vec::new();
+    // Forward ratio test only, comparable with `match_f32`; then the default with cross-check.
+    let forward = MatchConfig {
+        cross_check: false,
+        ..MatchConfig::default()
+    };
     group.bench_function("match_u8", |bench| {
+        bench.iter(|| {
+            match_features(&fa, &fb, &forward, &mut out);
+            out.len()
+        })
+    });
+    group.bench_function("match_u8_cross_check", |bench| {
         bench.iter(|| {
             match_features(&fa, &fb, &MatchConfig::default(), &mut out);
             out.len()

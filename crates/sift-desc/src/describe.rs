@@ -55,6 +55,27 @@ pub struct SiftFeature {
     pub descriptor: [u8; DESCRIPTOR_LEN],
 }
 
+/// `atan2(y, x)` by a degree-7 odd polynomial on `[0, 1]` plus octant folding: max error 2e-4
+/// rad (0.012°, tested), far below the 10° / 45° bins, and several times cheaper than libm's.
+#[inline]
+pub fn fast_atan2(y: f32, x: f32) -> f32 {
+    let (ax, ay) = (x.abs(), y.abs());
+    let (mn, mx) = if ax < ay { (ax, ay) } else { (ay, ax) };
+    if mx == 0.0 {
+        return 0.0;
+    }
+    let a = mn / mx;
+    let q = a * a;
+    let mut r = ((-0.046_496_475 * q + 0.159_314_22) * q - 0.327_622_76) * q * a + a;
+    if ay > ax {
+        r = std::f32::consts::FRAC_PI_2 - r;
+    }
+    if x < 0.0 {
+        r = std::f32::consts::PI - r;
+    }
+    if y < 0.0 { -r } else { r }
+}
+
 /// Central-difference gradient `(gx, gy)` at an interior pixel.
 #[inline]
 fn gradient(img: &Image, x: usize, y: usize) -> (f32, f32) {
@@ -142,18 +163,21 @@ fn orientation_histogram(
     };
     let inv = -1.0 / (2.0 * lambda_sigma * lambda_sigma);
     let scale = ORIENTATION_BINS as f32 / TAU;
+    // The Gaussian window is separable: one exp per row and column instead of per sample.
+    let wx: Vec<f32> = (x0..=x1)
+        .map(|m| ((m as f32 * delta - x).powi(2) * inv).exp())
+        .collect();
     for n in y0..=y1 {
-        let dy = n as f32 * delta - y;
-        for m in x0..=x1 {
-            let dx = m as f32 * delta - x;
+        let wy = ((n as f32 * delta - y).powi(2) * inv).exp();
+        for (m, &wxm) in (x0..=x1).zip(&wx) {
             let (gx, gy) = gradient(img, m, n);
             let mag = (gx * gx + gy * gy).sqrt();
             if mag == 0.0 {
                 continue;
             }
-            let angle = gy.atan2(gx).rem_euclid(TAU);
+            let angle = fast_atan2(gy, gx).rem_euclid(TAU);
             let bin = ((angle * scale).round() as usize) % ORIENTATION_BINS;
-            hist[bin] += ((dx * dx + dy * dy) * inv).exp() * mag;
+            hist[bin] += wxm * wy * mag;
         }
     }
     let mut tmp = [0f32; ORIENTATION_BINS];
@@ -186,9 +210,15 @@ fn descriptor(
     let inv = -1.0 / (2.0 * lambda * lambda);
     let ori_scale = N_ORI as f32 / TAU;
     let mut hist = [0f32; DESCRIPTOR_LEN];
+    // exp(-(u^2 + v^2) / (2 lambda^2)) is rotation invariant, hence separable in dx and dy.
+    let ws = inv / (sigma * sigma);
+    let wx: Vec<f32> = (x0..=x1)
+        .map(|m| ((m as f32 * delta - x).powi(2) * ws).exp())
+        .collect();
     for n in y0..=y1 {
         let dy = n as f32 * delta - y;
-        for m in x0..=x1 {
+        let wy = (dy * dy * ws).exp();
+        for (m, &wxm) in (x0..=x1).zip(&wx) {
             let dx = m as f32 * delta - x;
             // Coordinates in the keypoint's frame, in units of its scale.
             let u = (dx * cos + dy * sin) / sigma;
@@ -201,11 +231,12 @@ fn descriptor(
             if mag == 0.0 {
                 continue;
             }
-            let weight = ((u * u + v * v) * inv).exp() * mag;
+            let weight = wxm * wy * mag;
             // Continuous bin coordinates: histogram centres sit at integers 0..N_HIST.
             let bu = u / bin_width + (N_HIST as f32 - 1.0) / 2.0;
             let bv = v / bin_width + (N_HIST as f32 - 1.0) / 2.0;
-            let bo = ((gy.atan2(gx) - theta).rem_euclid(TAU) * ori_scale).rem_euclid(N_ORI as f32);
+            let bo =
+                ((fast_atan2(gy, gx) - theta).rem_euclid(TAU) * ori_scale).rem_euclid(N_ORI as f32);
             let (iu, iv, io) = (bu.floor(), bv.floor(), bo.floor());
             let (fu, fv, fo) = (bu - iu, bv - iv, bo - io);
             let (iu, iv, io) = (iu as isize, iv as isize, io as usize % N_ORI);
@@ -240,4 +271,26 @@ fn descriptor(
         *o = (512.0 * v / norm).min(255.0) as u8;
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fast_atan2_is_accurate_everywhere() {
+        let mut worst = 0f32;
+        for i in 0..2000 {
+            let t = i as f32 / 2000.0 * TAU;
+            for r in [1e-3f32, 0.7, 5.0] {
+                let (y, x) = (r * t.sin(), r * t.cos());
+                let d = (fast_atan2(y, x) - y.atan2(x)).abs();
+                worst = worst.max(d.min(TAU - d));
+            }
+        }
+        assert!(worst < 3e-4, "max error {worst}");
+        assert_eq!(fast_atan2(0.0, 0.0), 0.0);
+        assert_eq!(fast_atan2(1.0, 0.0), std::f32::consts::FRAC_PI_2);
+        assert_eq!(fast_atan2(0.0, -1.0), std::f32::consts::PI);
+    }
 }
