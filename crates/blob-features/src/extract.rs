@@ -201,7 +201,7 @@ impl Blobs {
         else {
             return;
         };
-        accumulate(&scratch.labels, n, grid, &mut scratch.acc);
+        accumulate(&scratch.labels, &scratch.mask, n, grid, &mut scratch.acc);
         for (i, acc) in scratch.acc.iter().enumerate() {
             if acc.area() < c.min_area.max(1) {
                 continue;

@@ -207,11 +207,11 @@ impl Labeler {
 }
 
 /// Bytes of mask tested at once when skipping background (most of a map is not an obstacle).
-const WORD: usize = 16;
+pub(crate) const WORD: usize = 16;
 
 /// Whether the `WORD` bytes of `m` are all zero (one 128-bit load instead of 16 branches).
 #[inline]
-fn is_zero_word(m: &[u8]) -> bool {
+pub(crate) fn is_zero_word(m: &[u8]) -> bool {
     m.try_into()
         .is_ok_and(|b: [u8; WORD]| u128::from_ne_bytes(b) == 0)
 }

@@ -6,6 +6,8 @@ use std::f64::consts::PI;
 
 use grid_core::{CellState, DVec2, OccupancyGrid};
 
+use crate::label::{WORD, is_zero_word};
+
 /// Inclusive pixel bounding box.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct BoundingBox {
@@ -181,11 +183,12 @@ fn log_scale(h: f64) -> f64 {
     }
 }
 
-/// Accumulate the statistics of every component of `labels` (`1..=n`, `0` background) into
-/// `acc` (resized to `n`). `grid` supplies the unknown cells for the contact measure; it must
+/// Accumulate the statistics of every component of `labels` (`1..=n`, `0` background, non-zero
+/// exactly where `mask` is) into `acc` (resized to `n`). `grid` supplies the unknown cells for the contact measure; it must
 /// have the labels' size.
 pub(crate) fn accumulate(
     labels: &[u32],
+    mask: &[u8],
     n: usize,
     grid: &OccupancyGrid,
     acc: &mut Vec<Accumulator>,
@@ -201,11 +204,20 @@ pub(crate) fn accumulate(
     };
     for y in 0..h {
         let row = &labels[y * w..(y + 1) * w];
-        for x in 0..w {
+        let mrow = &mask[y * w..(y + 1) * w];
+        let mut x = 0;
+        while x < w {
+            // Skip background a word at a time: most of a map is not an obstacle.
+            if x + WORD <= w && is_zero_word(&mrow[x..x + WORD]) {
+                x += WORD;
+                continue;
+            }
             let l = row[x];
+            x += 1;
             if l == 0 {
                 continue;
             }
+            let x = x - 1;
             let a = &mut acc[l as usize - 1];
             a.add(x as u32, y as u32);
             let edge = x == 0 || y == 0 || x + 1 == w || y + 1 == h;
