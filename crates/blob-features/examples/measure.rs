@@ -152,7 +152,48 @@ fn real_maps() {
     }
 }
 
+/// A 2 px thick, 200 px long wall at a random angle with each cell lost with probability
+/// `drop`: how many components of at least `min_area` cells it falls into, per closing radius.
+fn gappy_walls() {
+    println!("\n== gappy walls: components per wall (mean over 50 walls), by closing radius");
+    for drop in [0.1, 0.2, 0.3] {
+        let mut line = format!("cells lost {drop:.1}:");
+        for r in 0..3 {
+            let mut comps = 0;
+            for seed in 0..50u64 {
+                let mut rng = ChaCha8Rng::seed_from_u64(seed);
+                let angle = rng.random_range(-PI..PI);
+                let wall = common::Analytic::Rect {
+                    cx: 150.0,
+                    cy: 150.0,
+                    a: 100.0,
+                    b: 1.0,
+                    angle,
+                };
+                let (w, h) = (300, 300);
+                let mut cells = vec![0u8; w * h];
+                wall.paint(&mut cells, w, h, 100);
+                for c in cells.iter_mut() {
+                    if *c == 100 && rng.random::<f64>() < drop {
+                        *c = 0;
+                    }
+                }
+                let g = OccupancyGrid::from_cells(w, h, 0.05, Default::default(), cells).unwrap();
+                let cfg = BlobConfig {
+                    mask: blob_features::MaskKind::Occupied,
+                    close_radius: r,
+                    ..BlobConfig::default()
+                };
+                comps += extract(cfg, &g).len();
+            }
+            line += &format!("  r={r}: {:.2}", comps as f64 / 50.0);
+        }
+        println!("{line}");
+    }
+}
+
 fn main() {
+    gappy_walls();
     real_maps();
     let seeds = 0..20u64;
     let pairs: Vec<_> = seeds.map(pair).collect();

@@ -97,7 +97,10 @@ pub struct BlobConfig {
     /// Component connectivity. Default [`Connectivity::Eight`]: diagonal walls stay whole.
     pub connectivity: Connectivity,
     /// Radius (px) of the morphological closing applied to the obstacle mask before labelling,
-    /// so that a wall drawn with gaps by a noisy sensor stays one component. Default 1.
+    /// so that a wall drawn with gaps by a noisy sensor stays one component. Default 1: a
+    /// 200 px wall losing 10 % of its cells falls into 2.5 components at radius 0, 1.04 at
+    /// radius 1 and 1.04 at radius 2 (20 % lost: 4.0 / 1.58 / 1.50), and a larger radius merges
+    /// neighbouring obstacles.
     pub close_radius: usize,
     /// Components with fewer pixels are dropped (noise specks). Default 30: on simulated pairs
     /// (`mapsim`) it raised the share of true matches over 12 px without losing any.
