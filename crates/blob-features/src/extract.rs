@@ -91,8 +91,9 @@ pub enum UnknownPolicy {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BlobConfig {
     /// Which cells form components. Default [`MaskKind::NotFreeIslands`]: on simulated partial
-    /// maps the true partner of a blob ranked 1.8th on average in descriptor distance against
-    /// 6th-25th with [`MaskKind::Occupied`], whose components are fragments of visible surfaces.
+    /// maps (`mapsim`, see MEASUREMENTS.md) the true partner of a blob ranked 1.8th on average
+    /// in descriptor distance against 6th-25th with [`MaskKind::Occupied`], whose components
+    /// are fragments of visible surfaces.
     pub mask: MaskKind,
     /// Component connectivity. Default [`Connectivity::Eight`]: diagonal walls stay whole.
     pub connectivity: Connectivity,
@@ -103,12 +104,13 @@ pub struct BlobConfig {
     /// neighbouring obstacles.
     pub close_radius: usize,
     /// Components with fewer pixels are dropped (noise specks). Default 30: on simulated pairs
-    /// (`mapsim`) it raised the share of true matches over 12 px without losing any.
+    /// (`mapsim`, see MEASUREMENTS.md) it raised the share of true matches over 12 px without
+    /// losing any.
     pub min_area: usize,
     /// Above this `minor / major` eigenvalue ratio a component counts as round and gets no
     /// orientation. Default 0.6: on rigidly warped synthetic maps, true partners with roundness
-    /// below 0.6 agree on the rotation within 3 degrees in about 90 % of cases, above 0.6 in
-    /// under 70 % (`cargo run --release -p blob-features --example measure`).
+    /// below 0.6 agree on the rotation within 3 degrees in 85-94 % of cases, above 0.6 in
+    /// 33-71 % (`cargo run --release -p blob-features --example measure`).
     pub round_ratio: f64,
     /// Handling of components that border unknown cells. Default [`UnknownPolicy::Downweight`].
     pub unknown: UnknownPolicy,
