@@ -45,7 +45,7 @@ fn bench(c: &mut Criterion) {
     g.bench_function("close_r1", |b| {
         b.iter(|| {
             scratch_mask.copy_from_slice(&plan);
-            close(&mut scratch_mask, w, h, 1, &mut tmp)
+            close(&mut scratch_mask, w, h, 1, &mut tmp).unwrap()
         })
     });
     let cells: Vec<u8> = plan.iter().map(|&m| if m == 1 { 100 } else { 0 }).collect();

@@ -196,10 +196,12 @@ impl Blobs {
             MaskKind::Occupied => obstacle_mask(grid, &mut scratch.mask),
             MaskKind::NotFreeIslands => not_free_mask(grid, &mut scratch.mask),
         }
-        close(&mut scratch.mask, w, h, c.close_radius, &mut scratch.tmp);
+        // The mask has w * h entries by construction, so neither call below can fail on size;
+        // the only possible error is an image beyond 32-bit labels, which yields no blob.
+        if close(&mut scratch.mask, w, h, c.close_radius, &mut scratch.tmp).is_err() {
+            return;
+        }
         scratch.labeler.set_connectivity(c.connectivity);
-        // The mask has w * h entries by construction and a grid holds at most what fits in
-        // memory; the only possible error is an image beyond 32-bit labels, which yields no blob.
         let Ok(n) = scratch
             .labeler
             .label(&scratch.mask, w, h, &mut scratch.labels)

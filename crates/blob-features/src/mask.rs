@@ -3,6 +3,8 @@
 
 use grid_core::{CellState, OccupancyGrid};
 
+use crate::{BlobError, Result};
+
 /// Write the obstacle mask of `grid` into `out` (cleared first): `1` where
 /// [`OccupancyGrid::state`] is [`CellState::Occupied`], `0` elsewhere; row-major like the grid.
 pub fn obstacle_mask(grid: &OccupancyGrid, out: &mut Vec<u8>) {
@@ -37,11 +39,23 @@ pub fn not_free_mask(grid: &OccupancyGrid, out: &mut Vec<u8>) {
 /// cost is about `4 r` vectorised byte passes over the image; for the radii that matter here
 /// (1-2 px) a disk would differ by a handful of corner pixels.
 ///
-/// Panics if `mask.len() != width * height`.
-pub fn close(mask: &mut [u8], width: usize, height: usize, radius: usize, scratch: &mut Vec<u8>) {
-    assert_eq!(mask.len(), width * height, "mask size");
+/// Fails with [`BlobError::MaskSize`] when `mask.len() != width * height`.
+pub fn close(
+    mask: &mut [u8],
+    width: usize,
+    height: usize,
+    radius: usize,
+    scratch: &mut Vec<u8>,
+) -> Result<()> {
+    if width.checked_mul(height) != Some(mask.len()) {
+        return Err(BlobError::MaskSize {
+            got: mask.len(),
+            width,
+            height,
+        });
+    }
     if radius == 0 || mask.is_empty() {
-        return;
+        return Ok(());
     }
     // Pad by the radius so the dilation may spill over the border and the erosion can take it
     // back; then work on the padded copy.
@@ -66,6 +80,7 @@ pub fn close(mask: &mut [u8], width: usize, height: usize, radius: usize, scratc
             *m = p ^ 1;
         }
     }
+    Ok(())
 }
 
 /// Dilation of a `0`/`1` mask by a `(2r+1)` square, in place (outside counts as background);
@@ -150,9 +165,22 @@ mod tests {
                 })
                 .collect();
             let mut m = mask.clone();
-            close(&mut m, w, h, r, &mut Vec::new());
+            close(&mut m, w, h, r, &mut Vec::new()).unwrap();
             assert_eq!(m, close_oracle(&mask, w, h, r), "radius {r}");
         }
+    }
+
+    #[test]
+    fn closing_rejects_a_wrong_mask_size() {
+        let err = close(&mut [1, 0, 1], 2, 2, 1, &mut Vec::new()).unwrap_err();
+        assert_eq!(
+            err,
+            BlobError::MaskSize {
+                got: 3,
+                width: 2,
+                height: 2
+            }
+        );
     }
 
     #[test]
@@ -163,7 +191,7 @@ mod tests {
         for x in (0..w).filter(|&x| x != 5) {
             m[w + x] = 1;
         }
-        close(&mut m, w, h, 1, &mut Vec::new());
+        close(&mut m, w, h, 1, &mut Vec::new()).unwrap();
         assert!(m[w..2 * w].iter().all(|&v| v == 1));
         assert!(
             m[..w].iter().all(|&v| v == 0),
