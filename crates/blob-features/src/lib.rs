@@ -13,6 +13,11 @@
 //! [`match_blobs`]. [`Blobs`] implements [`grid_core::FeatureExtractor`] and
 //! [`BlobCorrespondences`] implements [`grid_core::CorrespondenceSource`]; to match one map
 //! against many, extract once with [`Blobs::extract_with`] and call [`match_blobs`] per pair.
+//!
+//! Strength and limit (numbers and commands in `MEASUREMENTS.md`): obstacles seen whole match
+//! well (about 90 % of matches within 2 px on rigidly warped maps); on partial maps from noisy
+//! lidars, where obstacles are thin one-sided traces, blobs give only a few true matches per
+//! pair at 10 % range noise and almost none at 30 %.
 
 mod error;
 mod extract;
