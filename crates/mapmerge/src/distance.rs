@@ -110,15 +110,15 @@ mod tests {
         let mut cells = vec![0u8; w * h];
         let mut s = 12345u64;
         let mut sites = Vec::new();
-        for i in 0..cells.len() {
+        for (i, cell) in cells.iter_mut().enumerate() {
             s = s
                 .wrapping_mul(6364136223846793005)
                 .wrapping_add(1442695040888963407);
             if (s >> 40) % 29 == 0 {
-                cells[i] = 100;
+                *cell = 100;
                 sites.push((i % w, i / w));
             } else if (s >> 40) % 7 == 0 {
-                cells[i] = UNKNOWN;
+                *cell = UNKNOWN;
             }
         }
         let g = OccupancyGrid::from_cells(w, h, 0.05, Pose2::default(), cells).unwrap();

@@ -11,4 +11,7 @@ pub mod refine;
 mod register;
 pub mod verify;
 
-pub use register::{Candidate, KindTotals, PairConfig, Registration, Timings, register_with};
+pub use register::{
+    Candidate, KindTotals, Method, PairConfig, RegisterConfig, Registration, Timings, register,
+    register_with,
+};

@@ -10,6 +10,8 @@ use clap::{Parser, Subcommand};
 
 const AFTER_HELP: &str = "\
 Examples:
+  mapmerge estimate fixtures/maps/sunil_pair_a/sunil_pair_a.yaml fixtures/maps/sunil_pair_b/sunil_pair_b.yaml
+  mapmerge estimate a.yaml b.yaml --json --debug-png matches.png
   mapmerge info fixtures/maps/wpi_ilab/wpi_ilab.yaml
   mapmerge info --json maps/robot1.yaml
   mapmerge info scan.pgm --resolution 0.1 --negate
@@ -19,8 +21,8 @@ image (.pgm/.pnm/.png). A bare image is read as a trinary map with resolution 0.
 origin [0, 0, 0], occupied_thresh 0.65 and free_thresh 0.196 unless the flags above say
 otherwise; those flags do not change maps given by YAML.
 
-Exit codes: 0 success, 2 bad usage or bad input (one line on stderr naming the file and the
-problem), 1 internal error.";
+Exit codes: 0 success, 3 no trustworthy match (estimate declined the pair), 2 bad usage or
+bad input (one line on stderr naming the file and the problem), 1 internal error.";
 
 /// Merge the occupancy grid maps of a robot team without knowing where each robot started.
 #[derive(Debug, Parser)]
@@ -36,6 +38,8 @@ struct Cli {
 enum Command {
     /// Print a map's size, resolution, origin and counts of free, occupied and unknown cells.
     Info(cmd::info::InfoArgs),
+    /// Find the rigid transform that maps map B onto map A, or decline the pair (exit 3).
+    Estimate(cmd::estimate::EstimateArgs),
 }
 
 fn main() -> ExitCode {
@@ -46,6 +50,7 @@ fn main() -> ExitCode {
         };
         match &cli.command {
             Command::Info(args) => cmd::info::run(args, &cli.bare),
+            Command::Estimate(args) => cmd::estimate::run(args, &cli.bare),
         }
     })
 }

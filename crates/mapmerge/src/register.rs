@@ -2,21 +2,47 @@
 
 use std::time::Instant;
 
+use blob_features::{BlobConfig, BlobCorrespondences, Blobs};
 use grid_core::{Correspondence, CorrespondenceSource, EvidenceKind, OccupancyGrid, Rigid2};
 use ransac_rigid::{RansacConfig, estimate_rigid};
+use sift_desc::{SiftConfig, SiftCorrespondences};
 
+use crate::global::{GlobalConfig, global_hypotheses};
 use crate::refine::{RefineConfig, refine};
 use crate::verify::{PreparedMap, Verification, VerifyConfig, verify};
 
 /// Everything that tunes [`register_with`], with documented defaults.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone)]
 pub struct PairConfig {
     /// RANSAC settings (seed included: the result is deterministic for a seed).
     pub ransac: RansacConfig,
-    /// ICP refinement of each candidate.
+    /// ICP refinement of each feature-based candidate.
     pub refine: RefineConfig,
     /// Verification thresholds that decide acceptance.
     pub verify: VerifyConfig,
+    /// Global search tried when no feature-based candidate passes verification; `None`
+    /// disables it. Default: on, [`GlobalConfig::default`].
+    pub global: Option<GlobalConfig>,
+    /// Refinement of global-search candidates: a wider first gate, since they come from a
+    /// coarse grid. Default: gate 12 px shrinking to 2 px, at most 24 px of movement.
+    pub global_refine: RefineConfig,
+}
+
+impl Default for PairConfig {
+    fn default() -> Self {
+        Self {
+            ransac: RansacConfig::default(),
+            refine: RefineConfig::default(),
+            verify: VerifyConfig::default(),
+            global: Some(GlobalConfig::default()),
+            global_refine: RefineConfig {
+                initial_gate_px: 12.0,
+                max_iterations: 25,
+                max_shift_px: 24.0,
+                ..RefineConfig::default()
+            },
+        }
+    }
 }
 
 /// One candidate transform after refinement and verification.
@@ -32,6 +58,8 @@ pub struct Candidate {
     pub verification: Verification,
     /// Whether it passes the verification thresholds.
     pub accepted: bool,
+    /// Where the hypothesis came from: `ransac` or `global`.
+    pub origin: &'static str,
 }
 
 /// Wall-clock time of each stage, in milliseconds.
@@ -45,6 +73,8 @@ pub struct Timings {
     pub prepare_ms: f64,
     /// Refinement and verification of all candidates.
     pub verify_ms: f64,
+    /// Global search, when it ran.
+    pub global_ms: f64,
 }
 
 /// The answer for one pair.
@@ -62,6 +92,9 @@ pub struct Registration {
     pub inliers: KindTotals,
     /// Stage timings.
     pub timings: Timings,
+    /// The putative correspondences themselves (for drawing), not serialised.
+    #[serde(skip)]
+    pub matches: Vec<Correspondence>,
 }
 
 /// A count per evidence kind.
@@ -115,17 +148,16 @@ pub fn register_with(
         correspondences,
         inliers: KindTotals::default(),
         timings,
+        matches: corrs.clone(),
     };
 
     let t0 = Instant::now();
-    let ransac = match estimate_rigid(&corrs, &config.ransac) {
-        Ok(r) => r,
-        Err(e) => {
-            timings.ransac_ms = ms(t0);
-            return declined(format!("no transform hypothesis: {e}"), timings, Vec::new());
-        }
-    };
+    let ransac = estimate_rigid(&corrs, &config.ransac);
     timings.ransac_ms = ms(t0);
+    let hypotheses = ransac
+        .as_ref()
+        .map(|r| r.hypotheses.as_slice())
+        .unwrap_or_default();
 
     let t0 = Instant::now();
     let (pa, pb) = rayon::join(
@@ -135,22 +167,40 @@ pub fn register_with(
     timings.prepare_ms = ms(t0);
 
     let t0 = Instant::now();
-    let mut candidates: Vec<Candidate> = ransac
-        .hypotheses
+    let check = |model: &Rigid2, refine_config: &RefineConfig, origin| {
+        let transform = refine(&pa, &pb, model, refine_config).normalized();
+        let verification = verify(&pa, &pb, &transform, &config.verify);
+        Candidate {
+            transform,
+            ransac_inliers: 0,
+            ransac_confidence: 0.0,
+            accepted: verification.accepted(&config.verify),
+            verification,
+            origin,
+        }
+    };
+    let mut candidates: Vec<Candidate> = hypotheses
         .iter()
-        .map(|h| {
-            let transform = refine(&pa, &pb, &h.model, &config.refine).normalized();
-            let verification = verify(&pa, &pb, &transform, &config.verify);
-            Candidate {
-                transform,
-                ransac_inliers: h.inliers_count,
-                ransac_confidence: h.confidence,
-                accepted: verification.accepted(&config.verify),
-                verification,
-            }
+        .map(|h| Candidate {
+            ransac_inliers: h.inliers_count,
+            ransac_confidence: h.confidence,
+            ..check(&h.model, &config.refine, "ransac")
         })
         .collect();
     timings.verify_ms = ms(t0);
+    if let Some(global) = &config.global {
+        if !candidates.iter().any(|c| c.accepted) {
+            let t0 = Instant::now();
+            let mut models = Vec::new();
+            global_hypotheses(&pa, &pb, global, &mut models);
+            candidates.extend(
+                models
+                    .iter()
+                    .map(|m| check(m, &config.global_refine, "global")),
+            );
+            timings.global_ms = ms(t0);
+        }
+    }
     candidates.sort_by(|x, y| {
         y.accepted
             .cmp(&x.accepted)
@@ -172,6 +222,7 @@ pub fn register_with(
                 correspondences,
                 inliers,
                 timings,
+                matches: corrs,
             }
         }
         Some(best) => {
@@ -184,6 +235,86 @@ pub fn register_with(
             );
             declined(reason, timings, candidates)
         }
-        None => declined("RANSAC produced no hypothesis".into(), timings, candidates),
+        None => {
+            let why = match &ransac {
+                Err(e) => format!("no transform hypothesis: {e}"),
+                Ok(_) => "no transform hypothesis".into(),
+            };
+            declined(why, timings, candidates)
+        }
     }
+}
+
+/// Which evidence gives the correspondences.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Method {
+    /// Intensity keypoints only (SIFT, 2-point hypotheses).
+    Sift,
+    /// Area keypoints only (obstacle components, 1-point hypotheses).
+    Blobs,
+    /// Both, scored together (the default).
+    #[default]
+    Hybrid,
+}
+
+impl std::fmt::Display for Method {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Method::Sift => "sift",
+            Method::Blobs => "blobs",
+            Method::Hybrid => "hybrid",
+        })
+    }
+}
+
+impl std::str::FromStr for Method {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "sift" => Ok(Method::Sift),
+            "blobs" => Ok(Method::Blobs),
+            "hybrid" => Ok(Method::Hybrid),
+            _ => Err(format!(
+                "unknown method '{s}' (expected sift, blobs or hybrid)"
+            )),
+        }
+    }
+}
+
+/// Settings of [`register`]: the method, each source's settings and the pair settings.
+#[derive(Debug, Clone, Default)]
+pub struct RegisterConfig {
+    /// Which correspondences to use. Default [`Method::Hybrid`].
+    pub method: Method,
+    /// SIFT settings (defaults of `sift-desc`).
+    pub sift: SiftConfig,
+    /// Component settings (defaults of `blob-features`).
+    pub blobs: BlobConfig,
+    /// Component matching settings.
+    pub blob_matching: blob_features::MatchConfig,
+    /// RANSAC, refinement, verification and global search.
+    pub pair: PairConfig,
+}
+
+/// Register `b` onto `a` with the method of `config`.
+///
+/// Fails only for an invalid SIFT configuration; a pair without a trustworthy answer comes
+/// back with `accepted: None` and a reason.
+pub fn register(
+    a: &OccupancyGrid,
+    b: &OccupancyGrid,
+    config: &RegisterConfig,
+) -> Result<Registration, sift_desc::Error> {
+    let sift = SiftCorrespondences::new(config.sift.clone())?;
+    let blobs = BlobCorrespondences {
+        blobs: Blobs::new(config.blobs),
+        matching: config.blob_matching,
+    };
+    let sources: Vec<&dyn CorrespondenceSource> = match config.method {
+        Method::Sift => vec![&sift],
+        Method::Blobs => vec![&blobs],
+        Method::Hybrid => vec![&sift, &blobs],
+    };
+    Ok(register_with(a, b, &sources, &config.pair))
 }

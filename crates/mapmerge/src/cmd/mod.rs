@@ -5,6 +5,7 @@
 //! match" for the registration commands) and `Err` for everything else; [`run_main`] prints an
 //! `Err` as one line and picks its exit code with [`exit_code_for`].
 
+pub mod estimate;
 pub mod info;
 
 use std::process::ExitCode;

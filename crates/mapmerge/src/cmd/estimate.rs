@@ -1,0 +1,335 @@
+//! `mapmerge estimate A B [--json]`: the rigid transform mapping map B onto map A.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::Context;
+use clap::Args;
+use grid_core::{CellState, DVec2, OccupancyGrid, Rigid2};
+use mapmerge::{Method, RegisterConfig, Registration, register};
+use serde_json::json;
+
+use super::{BareImageArgs, UsageError, load};
+
+const AFTER: &str = "\
+Output (--json): one JSON object on stdout.
+  transform        {theta, tx, ty}: maps a pixel (x = column, y = row from the top) of B onto A:
+                   x_a = cos(theta) x_b - sin(theta) y_b + tx, y_a = sin(theta) x_b + cos(theta) y_b + ty
+                   null when the pair is declined (exit code 3), with \"reason\" saying why
+  world            {x, y, yaw}: B's map frame in A's map frame (metres, yaw counter-clockwise),
+                   ready to publish as a TF from A's map frame to B's
+  inliers          correspondences within 3 px of the answer; inliers_by_kind splits them
+  confidence       wall lift of the answer: 0 is what a random placement scores, 1 is perfect
+                   agreement of the walls; pairs are accepted from 0.65 (and acceptance index
+                   >= 0.8, overlap >= 3 % of the smaller map)
+  verification     wall_agreement, wall_lift, acceptance_index, overlap_cells, overlap_fraction
+  method, hypothesis (ransac or global), correspondences, candidates, timings_ms
+
+Exit codes: 0 transform found, 3 no trustworthy match (the pair is declined), 2 bad usage or
+bad input, 1 internal error.
+
+Examples:
+  mapmerge estimate fixtures/maps/sunil_pair_a/sunil_pair_a.yaml fixtures/maps/sunil_pair_b/sunil_pair_b.yaml
+  mapmerge estimate a.yaml b.yaml --json --debug-png matches.png";
+
+/// Arguments of `mapmerge estimate`.
+#[derive(Debug, Clone, Args)]
+#[command(after_help = AFTER)]
+pub struct EstimateArgs {
+    /// Map A (the reference): a map_server YAML or a bare .pgm/.png image
+    #[arg(value_name = "A")]
+    pub a: PathBuf,
+    /// Map B (the one being placed into A's frame)
+    #[arg(value_name = "B")]
+    pub b: PathBuf,
+    /// Print one JSON object instead of text
+    #[arg(long)]
+    pub json: bool,
+    /// Evidence used for correspondences: sift (intensity keypoints), blobs (obstacle
+    /// components) or hybrid (both)
+    #[arg(long, default_value = "hybrid", value_parser = parse_method)]
+    pub method: Method,
+    /// Seed of RANSAC; the same seed gives the same answer
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Write a picture of A, B with the matches (green: inliers, red: outliers) and B laid
+    /// over A with the answer (A's walls blue, B's red, agreeing walls black)
+    #[arg(long, value_name = "FILE")]
+    pub debug_png: Option<PathBuf>,
+}
+
+fn parse_method(s: &str) -> Result<Method, String> {
+    s.parse()
+}
+
+fn same_file(a: &Path, b: &Path) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(x), Ok(y)) => x == y,
+        _ => a == b,
+    }
+}
+
+/// Run `mapmerge estimate`.
+pub fn run(args: &EstimateArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode> {
+    if let Some(png) = &args.debug_png {
+        if same_file(png, &args.a) || same_file(png, &args.b) {
+            return Err(UsageError(format!(
+                "{}: --debug-png would overwrite an input map; choose another file",
+                png.display()
+            ))
+            .into());
+        }
+    }
+    let a = load(&args.a, bare)?;
+    let b = load(&args.b, bare)?;
+    grid_core::io::require_known_cells(&a.grid, &args.a)?;
+    grid_core::io::require_known_cells(&b.grid, &args.b)?;
+    let (ra, rb) = (a.grid.resolution(), b.grid.resolution());
+    if ((ra - rb) / ra).abs() > 1e-6 {
+        return Err(UsageError(format!(
+            "{}: resolution {rb} m/cell differs from {}'s {ra} m/cell; a rigid pixel transform \
+             needs equal resolutions, so resample one map first",
+            args.b.display(),
+            args.a.display()
+        ))
+        .into());
+    }
+    let mut config = RegisterConfig {
+        method: args.method,
+        ..RegisterConfig::default()
+    };
+    config.pair.ransac.seed = args.seed;
+    let result = register(&a.grid, &b.grid, &config).context("invalid registration settings")?;
+    if let Some(png) = &args.debug_png {
+        write_debug_png(
+            png,
+            &a.grid,
+            &b.grid,
+            &result,
+            config.pair.ransac.threshold_px,
+        )?;
+    }
+    let out = report(args, &a.grid, &b.grid, &result);
+    let mut stdout = std::io::stdout().lock();
+    if args.json {
+        writeln!(stdout, "{out}").context("cannot write to stdout")?;
+    } else {
+        human(&mut stdout, &out).context("cannot write to stdout")?;
+    }
+    Ok(ExitCode::from(if result.accepted.is_some() {
+        0
+    } else {
+        3
+    }))
+}
+
+fn report(
+    args: &EstimateArgs,
+    a: &OccupancyGrid,
+    b: &OccupancyGrid,
+    r: &Registration,
+) -> serde_json::Value {
+    let common = json!({
+        "a": args.a.display().to_string(),
+        "b": args.b.display().to_string(),
+        "method": args.method,
+        "seed": args.seed,
+        "correspondences": r.correspondences,
+        "candidates": r.candidates.len(),
+        "timings_ms": r.timings,
+    });
+    let mut out = match &r.accepted {
+        Some(c) => {
+            let w = c.transform.to_world(&a.geometry(), &b.geometry());
+            json!({
+                "transform": {"theta": c.transform.theta, "tx": c.transform.tx, "ty": c.transform.ty},
+                "world": {"x": w.tx, "y": w.ty, "yaw": w.theta},
+                "inliers": r.inliers.intensity + r.inliers.area,
+                "inliers_by_kind": r.inliers,
+                "confidence": c.verification.wall_lift.clamp(0.0, 1.0),
+                "verification": c.verification,
+                "hypothesis": c.origin,
+            })
+        }
+        None => json!({
+            "transform": null,
+            "reason": r.reason.clone().unwrap_or_else(|| "no trustworthy match".into()),
+            "best_rejected": r.candidates.first().map(|c| json!({
+                "transform": {"theta": c.transform.theta, "tx": c.transform.tx, "ty": c.transform.ty},
+                "verification": c.verification,
+            })),
+        }),
+    };
+    if let (Some(o), Some(c)) = (out.as_object_mut(), common.as_object()) {
+        o.extend(c.clone());
+    }
+    out
+}
+
+fn human(w: &mut impl Write, o: &serde_json::Value) -> std::io::Result<()> {
+    let f = |k: &str| o[k].as_f64().unwrap_or(f64::NAN);
+    if o["transform"].is_null() {
+        writeln!(
+            w,
+            "no trustworthy match: {}",
+            o["reason"].as_str().unwrap_or("?")
+        )?;
+    } else {
+        let t = &o["transform"];
+        let wd = &o["world"];
+        writeln!(
+            w,
+            "B -> A (pixels): theta {:.3} deg, tx {:.2} px, ty {:.2} px",
+            t["theta"].as_f64().unwrap_or(0.0).to_degrees(),
+            t["tx"].as_f64().unwrap_or(0.0),
+            t["ty"].as_f64().unwrap_or(0.0)
+        )?;
+        writeln!(
+            w,
+            "B's map frame in A's (world): x {:.3} m, y {:.3} m, yaw {:.3} deg",
+            wd["x"].as_f64().unwrap_or(0.0),
+            wd["y"].as_f64().unwrap_or(0.0),
+            wd["yaw"].as_f64().unwrap_or(0.0).to_degrees()
+        )?;
+        let v = &o["verification"];
+        writeln!(
+            w,
+            "confidence {:.2} (wall lift), acceptance index {:.3}, overlap {:.1}% of the smaller map, {} inliers ({} hypothesis)",
+            f("confidence"),
+            v["acceptance_index"].as_f64().unwrap_or(0.0),
+            100.0 * v["overlap_fraction"].as_f64().unwrap_or(0.0),
+            o["inliers"],
+            o["hypothesis"].as_str().unwrap_or("?")
+        )?;
+    }
+    let t = &o["timings_ms"];
+    let total: f64 = [
+        "correspondences_ms",
+        "ransac_ms",
+        "prepare_ms",
+        "verify_ms",
+        "global_ms",
+    ]
+    .iter()
+    .map(|k| t[*k].as_f64().unwrap_or(0.0))
+    .sum();
+    writeln!(
+        w,
+        "{} correspondences ({} intensity, {} area), {} candidates checked, {:.0} ms",
+        o["correspondences"]["intensity"].as_u64().unwrap_or(0)
+            + o["correspondences"]["area"].as_u64().unwrap_or(0),
+        o["correspondences"]["intensity"],
+        o["correspondences"]["area"],
+        o["candidates"],
+        total
+    )
+}
+
+fn shade(s: CellState) -> [u8; 3] {
+    match s {
+        CellState::Free => [255, 255, 255],
+        CellState::Occupied => [0, 0, 0],
+        CellState::Unknown => [205, 205, 205],
+    }
+}
+
+fn line(img: &mut image::RgbImage, p: DVec2, q: DVec2, colour: [u8; 3]) {
+    let n = (q - p).abs().max_element().ceil().max(1.0) as usize;
+    for i in 0..=n {
+        let r = p + (q - p) * (i as f64 / n as f64);
+        let (x, y) = (r.x.round(), r.y.round());
+        if x >= 0.0 && y >= 0.0 && (x as u32) < img.width() && (y as u32) < img.height() {
+            img.put_pixel(x as u32, y as u32, image::Rgb(colour));
+        }
+    }
+}
+
+/// Three panels: A, B (with match lines between them), and B laid over A with the answer.
+fn write_debug_png(
+    path: &Path,
+    a: &OccupancyGrid,
+    b: &OccupancyGrid,
+    r: &Registration,
+    threshold: f64,
+) -> anyhow::Result<()> {
+    const GAP: usize = 10;
+    let (wa, ha, wb, hb) = (a.width(), a.height(), b.width(), b.height());
+    let width = 2 * wa + wb + 2 * GAP;
+    let height = ha.max(hb);
+    anyhow::ensure!(
+        (width as u64) * (height as u64) <= 200_000_000,
+        "{}: the debug picture would be {width} x {height} pixels; too large",
+        path.display()
+    );
+    let mut img =
+        image::RgbImage::from_pixel(width as u32, height as u32, image::Rgb([90, 90, 90]));
+    for y in 0..ha {
+        for x in 0..wa {
+            img.put_pixel(x as u32, y as u32, image::Rgb(shade(a.state(x, y))));
+        }
+    }
+    let bx = wa + GAP;
+    for y in 0..hb {
+        for x in 0..wb {
+            img.put_pixel((bx + x) as u32, y as u32, image::Rgb(shade(b.state(x, y))));
+        }
+    }
+    let t = r
+        .accepted
+        .as_ref()
+        .map(|c| c.transform)
+        .or_else(|| r.candidates.first().map(|c| c.transform));
+    for c in &r.matches {
+        let inlier = t.is_some_and(|t: Rigid2| (c.a - t.apply(c.b)).length() <= threshold);
+        let colour = if inlier { [0, 170, 0] } else { [220, 40, 40] };
+        line(&mut img, c.a, c.b + DVec2::new(bx as f64, 0.0), colour);
+    }
+    // Overlay in A's frame.
+    let ox = 2 * wa + 2 * GAP;
+    if let Some(t) = t {
+        let inv = t.inverse();
+        for y in 0..ha {
+            for x in 0..wa {
+                let q = inv.apply(DVec2::new(x as f64, y as f64)).round();
+                let sb = if q.x >= 0.0 && q.y >= 0.0 {
+                    b.state(q.x as usize, q.y as usize)
+                } else {
+                    CellState::Unknown
+                };
+                let sa = a.state(x, y);
+                let colour = match (sa, sb) {
+                    (CellState::Occupied, CellState::Occupied) => [0, 0, 0],
+                    (CellState::Occupied, _) => [40, 80, 230],
+                    (_, CellState::Occupied) => [230, 40, 40],
+                    (CellState::Free, _) | (_, CellState::Free) => [255, 255, 255],
+                    _ => [205, 205, 205],
+                };
+                img.put_pixel((ox + x) as u32, y as u32, image::Rgb(colour));
+            }
+        }
+    }
+    let dir = path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let tmp = dir.join(format!(
+        ".{}.tmp{}",
+        path.file_name()
+            .and_then(|n| n.to_str())
+            .unwrap_or("debug.png"),
+        std::process::id()
+    ));
+    let result = img
+        .save_with_format(&tmp, image::ImageFormat::Png)
+        .map_err(|e| anyhow::anyhow!("{}: cannot write the debug picture: {e}", path.display()))
+        .and_then(|()| {
+            std::fs::rename(&tmp, path).map_err(|e| {
+                anyhow::anyhow!("{}: cannot write the debug picture: {e}", path.display())
+            })
+        });
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
