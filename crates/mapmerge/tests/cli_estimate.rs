@@ -1,0 +1,214 @@
+//! `mapmerge estimate` through the real binary: known transforms recovered on real maps,
+//! unrelated maps declined with exit code 3, bad input refused with exit code 2.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use grid_core::io::{LoadOptions, load_map, save_map};
+use grid_core::metrics::{displacement_error, rotation_error_deg};
+use grid_core::{CellState, DVec2, OccupancyGrid, Rigid2};
+use tempfile::TempDir;
+
+fn fixture(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../../fixtures/maps/{name}/{name}.yaml"))
+}
+
+fn run(args: &[&Path]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_mapmerge"))
+        .arg("estimate")
+        .args(args)
+        .arg("--json")
+        .output()
+        .unwrap()
+}
+
+fn json(out: &Output) -> serde_json::Value {
+    let text = String::from_utf8(out.stdout.clone()).unwrap();
+    assert_eq!(text.lines().count(), 1, "one JSON object: {text}");
+    serde_json::from_str(&text).unwrap()
+}
+
+fn transform(v: &serde_json::Value) -> Rigid2 {
+    let t = &v["transform"];
+    Rigid2::new(
+        t["theta"].as_f64().unwrap(),
+        t["tx"].as_f64().unwrap(),
+        t["ty"].as_f64().unwrap(),
+    )
+}
+
+/// Centre of the known cells of `g`.
+fn known_centre(g: &OccupancyGrid) -> DVec2 {
+    let (mut s, mut n) = (DVec2::ZERO, 0.0);
+    for y in 0..g.height() {
+        for x in 0..g.width() {
+            if g.state(x, y) != CellState::Unknown {
+                s += DVec2::new(x as f64, y as f64);
+                n += 1.0;
+            }
+        }
+    }
+    s / n
+}
+
+/// Write B = a rotated, shifted crop of `a` (B's centre lands on A's known centre plus `shift`)
+/// and return its path and the true B→A transform.
+fn rotated_crop(
+    dir: &TempDir,
+    a: &OccupancyGrid,
+    theta_deg: f64,
+    size: usize,
+    shift: DVec2,
+) -> (PathBuf, Rigid2) {
+    let half = DVec2::splat(size as f64 / 2.0);
+    let rot = DVec2::from_angle(theta_deg.to_radians());
+    let t = known_centre(a) + shift - rot.rotate(half);
+    let truth = Rigid2::new(theta_deg.to_radians(), t.x, t.y);
+    let b = a.warp(&truth.inverse(), size, size).unwrap();
+    let path = dir.path().join("b.yaml");
+    save_map(&b, &path).unwrap();
+    (path, truth)
+}
+
+#[test]
+fn recovers_a_rotated_cropped_copy_of_a_real_map() {
+    let dir = TempDir::new().unwrap();
+    for (name, theta, size) in [("aws_small_house", 37.0, 300), ("wpi_ilab", -121.0, 180)] {
+        let a_path = fixture(name);
+        let a = load_map(&a_path, &LoadOptions::default()).unwrap();
+        let (b_path, truth) = rotated_crop(&dir, &a, theta, size, DVec2::new(7.3, -4.6));
+        let out = run(&[&a_path, &b_path]);
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{name}: {}",
+            String::from_utf8_lossy(&out.stdout)
+        );
+        let v = json(&out);
+        let est = transform(&v);
+        let b = load_map(&b_path, &LoadOptions::default()).unwrap();
+        let rot = rotation_error_deg(&est, &truth);
+        let disp = displacement_error(&b, &est, &truth).unwrap();
+        assert!(rot < 0.5, "{name}: rotation error {rot} deg");
+        assert!(disp < 1.0, "{name}: displacement error {disp} px");
+        assert!(v["confidence"].as_f64().unwrap() >= 0.65, "{v}");
+        // The world form is the same answer in ROS terms (both maps have the origin of A's
+        // YAML or map_saver's, so just check it is the conversion of the pixel answer).
+        let w = est.to_world(&a.geometry(), &b.geometry());
+        assert!((v["world"]["yaw"].as_f64().unwrap() - w.theta).abs() < 1e-9);
+        assert!((v["world"]["x"].as_f64().unwrap() - w.tx).abs() < 1e-9);
+    }
+}
+
+#[test]
+fn registers_the_real_overlapping_pair() {
+    // Two real partial maps of one building (Sunil et al. 2023); no ground truth is published,
+    // so the check is the agreement of the maps under the answer: the shared room lines up.
+    let out = run(&[&fixture("sunil_pair_a"), &fixture("sunil_pair_b")]);
+    assert_eq!(out.status.code(), Some(0));
+    let v = json(&out);
+    assert!(
+        v["verification"]["acceptance_index"].as_f64().unwrap() > 0.95,
+        "{v}"
+    );
+    assert!(
+        v["verification"]["overlap_fraction"].as_f64().unwrap() > 0.2,
+        "{v}"
+    );
+}
+
+#[test]
+fn unrelated_maps_are_declined_with_exit_3() {
+    for (a, b) in [("wpi_ilab", "tb3_world"), ("aws_small_house", "wpi_ilab")] {
+        let out = run(&[&fixture(a), &fixture(b)]);
+        let v = json(&out);
+        assert_eq!(out.status.code(), Some(3), "{a} vs {b}: {v}");
+        assert!(v["transform"].is_null());
+        assert!(
+            v["reason"].as_str().unwrap().contains("verification"),
+            "{v}"
+        );
+    }
+}
+
+#[test]
+fn same_seed_gives_the_same_answer() {
+    let a = fixture("sunil_pair_a");
+    let b = fixture("sunil_pair_b");
+    let first = json(&run(&[&a, &b]));
+    let second = json(&run(&[&a, &b]));
+    assert_eq!(first["transform"], second["transform"]);
+}
+
+fn fails(args: &[&str]) -> String {
+    let out = Command::new(env!("CARGO_BIN_EXE_mapmerge"))
+        .arg("estimate")
+        .args(args)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+    assert!(out.stdout.is_empty());
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    stderr.trim_end().to_string()
+}
+
+#[test]
+fn bad_input_is_refused_with_exit_2() {
+    let dir = TempDir::new().unwrap();
+    let a = fixture("wpi_ilab");
+    let a_s = a.to_str().unwrap();
+    let missing = dir.path().join("nope.yaml");
+    let err = fails(&[a_s, missing.to_str().unwrap()]);
+    assert!(
+        err.starts_with(&format!("mapmerge: error: {}: ", missing.display())),
+        "{err}"
+    );
+
+    // Different resolutions cannot be related by a rigid pixel transform.
+    let err = fails(&[a_s, fixture("intel_lab").to_str().unwrap()]);
+    assert!(err.contains("resolution 0.1 m/cell differs"), "{err}");
+
+    // An all-unknown map has nothing to register.
+    let blank = OccupancyGrid::new(20, 10, 0.05, Default::default()).unwrap();
+    let blank_path = dir.path().join("blank.yaml");
+    save_map(&blank, &blank_path).unwrap();
+    let err = fails(&[a_s, blank_path.to_str().unwrap()]);
+    assert!(
+        err.contains(&blank_path.display().to_string()) && err.contains("unknown"),
+        "{err}"
+    );
+
+    // The debug picture never overwrites an input.
+    let err = fails(&[a_s, a_s, "--debug-png", a_s]);
+    assert!(err.contains("would overwrite an input map"), "{err}");
+
+    let err = fails(&[a_s, a_s, "--method", "orb"]);
+    assert!(err.contains("unknown method 'orb'"), "{err}");
+}
+
+#[test]
+fn debug_png_is_written() {
+    let dir = TempDir::new().unwrap();
+    let png = dir.path().join("m.png");
+    let out = Command::new(env!("CARGO_BIN_EXE_mapmerge"))
+        .args([
+            "estimate",
+            fixture("sunil_pair_a").to_str().unwrap(),
+            fixture("sunil_pair_b").to_str().unwrap(),
+        ])
+        .arg("--debug-png")
+        .arg(&png)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0));
+    let img = image::open(&png).unwrap();
+    // Three panels: A, B and the overlay in A's frame, 10 px apart.
+    let (a, b) = (380, 500);
+    assert_eq!((img.width(), img.height()), (2 * a + b + 20, 500));
+    assert_eq!(
+        std::fs::read_dir(dir.path()).unwrap().count(),
+        1,
+        "no temporary file left"
+    );
+}
