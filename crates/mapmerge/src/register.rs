@@ -206,6 +206,29 @@ pub fn register_with(
             .cmp(&x.accepted)
             .then(y.verification.score().total_cmp(&x.verification.score()))
     });
+    // Ambiguity: another accepted, clearly different placement that scores almost as well.
+    let centre_b = pb.wall_samples.iter().copied().sum::<grid_core::DVec2>()
+        / pb.wall_samples.len().max(1) as f64;
+    let rival = candidates.first().filter(|b| b.accepted).and_then(|best| {
+        candidates.iter().skip(1).find(|c| {
+            c.accepted
+                && (c.verification.score()
+                    >= config.verify.max_ambiguity * best.verification.score()
+                    || c.verification.wall_lift >= best.verification.wall_lift)
+                && (grid_core::wrap_angle(c.transform.theta - best.transform.theta).abs()
+                    > 3f64.to_radians()
+                    || (c.transform.apply(centre_b) - best.transform.apply(centre_b)).length()
+                        > 5.0)
+        })
+    });
+    if let (Some(best), Some(rival)) = (candidates.first(), rival) {
+        let reason = format!(
+            "ambiguous: two different placements fit almost equally well (scores {:.0} and {:.0}); the maps share too little distinctive structure",
+            best.verification.score(),
+            rival.verification.score()
+        );
+        return declined(reason, timings, candidates);
+    }
     match candidates.first() {
         Some(best) if best.accepted => {
             // Inliers of the final (refined) transform, so the split by kind describes the answer.

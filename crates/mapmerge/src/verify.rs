@@ -31,6 +31,12 @@ pub struct VerifyConfig {
     pub min_wall_support: usize,
     /// Minimum overlap, as a fraction of the smaller map's known cells. Default 0.03.
     pub min_overlap_fraction: f64,
+    /// A pair is ambiguous, and declined, when a second accepted candidate that differs from
+    /// the best (by more than 3 degrees or 5 px) scores at least this fraction of the best's
+    /// [`Verification::score`], or fits its walls at least as well (wall lift as high). Default
+    /// 0.6. Sparse maps (a few walls) fit many placements
+    /// equally well; returning one of them would be a confident wrong answer.
+    pub max_ambiguity: f64,
 }
 
 impl Default for VerifyConfig {
@@ -42,6 +48,7 @@ impl Default for VerifyConfig {
             min_acceptance_index: 0.80,
             min_wall_support: 40,
             min_overlap_fraction: 0.03,
+            max_ambiguity: 0.6,
         }
     }
 }
