@@ -1,1 +1,30 @@
-fn main() {}
+//! Project automation (`cargo xtask <command>`): one module per command; this file only
+//! dispatches. Not shipped; not a library.
+
+use clap::{Parser, Subcommand};
+
+mod eval;
+mod r#gen;
+
+/// mapmerge project tasks.
+#[derive(Parser)]
+#[command(name = "xtask")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Generate simulated robot-team cases (partial maps with known truth).
+    Gen(r#gen::Args),
+    /// Measure registration accuracy, decline rate and time on regenerable simulated suites.
+    Eval(eval::EvalArgs),
+}
+
+fn main() -> anyhow::Result<()> {
+    match Cli::parse().command {
+        Command::Gen(args) => r#gen::run(args),
+        Command::Eval(args) => eval::run(args),
+    }
+}

@@ -1,0 +1,425 @@
+//! Robot-team simulator: the ground-truth factory of mapmerge.
+//!
+//! It is for: building seeded worlds (disaster area, indoor floor, or a given map), driving a
+//! team of robots along collision-free paths with noisy range sensors, and returning each
+//! robot's partial occupancy map in its own randomly rotated and shifted frame, together with
+//! the exact pixel transforms between the maps ([`Case::truth`]) and the achieved overlap of
+//! their explored areas. The registration crates use [`strategies`] in property tests and the
+//! evaluation harness uses [`generate_case`] to build suites.
+//!
+//! It is not for: SLAM (poses are perfect; only ranges are noisy), registration, or map I/O.
+//!
+//! Frames: every transform follows the project conventions (pixel `x` column, `y` row from
+//! the top, integer coordinates at pixel centres). `RobotMap::map_to_world` maps a pixel of the
+//! robot's map to a pixel of the world raster; `Case::truth(i, j)` maps a pixel of map `j` onto
+//! map `i`. Maps are rendered by casting each beam in the world and rasterising the same beam,
+//! moved rigidly, in the robot's frame, so the truth is exact (no resampling).
+//!
+//! Determinism: the same [`CaseConfig`] and seed give the same [`Case`], bit for bit, whatever
+//! the number of threads.
+
+use std::f64::consts::PI;
+
+use glam::DVec2;
+use grid_core::{OccupancyGrid, Rigid2, UNKNOWN};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+
+mod overlap;
+mod planner;
+mod raycast;
+mod sensor;
+#[cfg(feature = "proptest")]
+pub mod strategies;
+mod world;
+
+pub use world::{World, WorldConfig, WorldKind};
+
+/// Result alias of this crate.
+pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+/// Everything that can go wrong when generating a case.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// A configuration value is out of range; the message names the field.
+    #[error("invalid configuration: {0}")]
+    Config(String),
+    /// World dimensions out of the supported range.
+    #[error("world size {width} x {height} is outside the supported range (24..=20000 a side)")]
+    WorldSize {
+        /// Width in cells.
+        width: usize,
+        /// Height in cells.
+        height: usize,
+    },
+    /// An obstacle raster of the wrong length.
+    #[error("obstacle raster has {got} cells, expected {expected}")]
+    RasterLen {
+        /// Cells given.
+        got: usize,
+        /// `width * height`.
+        expected: usize,
+    },
+    /// The world has no free region wide enough for a robot to drive through.
+    #[error("the world has no free region wide enough for the robots")]
+    NoFreeSpace,
+    /// The achieved overlap is further than the tolerance from the requested one.
+    #[error(
+        "achieved overlap {achieved:.3} is more than {tolerance} from the requested {requested}"
+    )]
+    OverlapMissed {
+        /// Requested overlap fraction.
+        requested: f64,
+        /// What the generated maps have.
+        achieved: f64,
+        /// The configured tolerance.
+        tolerance: f64,
+    },
+    /// A grid could not be built.
+    #[error(transparent)]
+    Grid(#[from] grid_core::Error),
+}
+
+/// One robot's sensor.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct RobotConfig {
+    /// Beams, evenly spread over 360 degrees, beam 0 along the heading. Default 360 (lidar);
+    /// 16 for an infrared ring.
+    pub beams: usize,
+    /// Maximum range in cells; farther obstacles return nothing. Default 80.
+    pub max_range: f64,
+    /// Multiplicative range noise bound `b`: a hit at true range `r` reads `r (1 + U(-b, b))`.
+    /// Default 0.02.
+    pub noise_bound: f64,
+    /// Probability that a beam returns no reading at all. Default 0.
+    pub dropout: f64,
+    /// Indices of beams that never return a reading (failed sensors). Default empty.
+    pub failed_beams: Vec<usize>,
+}
+
+impl Default for RobotConfig {
+    fn default() -> Self {
+        Self {
+            beams: 360,
+            max_range: 80.0,
+            noise_bound: 0.02,
+            dropout: 0.0,
+            failed_beams: Vec::new(),
+        }
+    }
+}
+
+impl RobotConfig {
+    /// The paper's infrared ring: 16 beams, range 30 cells, the given noise bound.
+    pub fn infrared(noise_bound: f64) -> Self {
+        Self {
+            beams: 16,
+            max_range: 30.0,
+            noise_bound,
+            ..Self::default()
+        }
+    }
+}
+
+/// Everything that defines a case, apart from the seed.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CaseConfig {
+    /// The world. Default: 400 x 400 disaster area.
+    pub world: WorldConfig,
+    /// One entry per robot, at least 2 and at most 32. Default: two default lidars.
+    pub robots: Vec<RobotConfig>,
+    /// Requested overlap of consecutive robots' explored areas, as a fraction of the smaller
+    /// one, in `[0, 1]`. `0` asks for disjoint explored areas. Default 0.5.
+    pub overlap: f64,
+    /// Largest accepted `|achieved - requested|` overlap; generation fails with
+    /// [`Error::OverlapMissed`] beyond it. Default 0.1 (`f64::INFINITY` never fails).
+    pub overlap_tolerance: f64,
+    /// Each map's rotation is drawn from `U(-max_rotation, max_rotation)` radians. Default pi.
+    pub max_rotation: f64,
+    /// Unknown margin around each robot's explored area, in cells. Default 5.
+    pub margin: usize,
+    /// A random extra margin `U(0, extra_margin)` per side, so the maps' offsets vary. Default 20.
+    pub extra_margin: usize,
+    /// Distance between consecutive poses along a path, in cells. Default 2.
+    pub pose_step: f64,
+    /// Minimum distance (cells) from path to obstacles: the planner's robot radius. Default 3.
+    pub clearance: f64,
+    /// Spacing of the exploration waypoints in cells; `None` = 0.8 x the smallest max range.
+    pub waypoint_spacing: Option<f64>,
+}
+
+impl Default for CaseConfig {
+    fn default() -> Self {
+        Self {
+            world: WorldConfig::default(),
+            robots: vec![RobotConfig::default(), RobotConfig::default()],
+            overlap: 0.5,
+            overlap_tolerance: 0.1,
+            max_rotation: PI,
+            margin: 5,
+            extra_margin: 20,
+            pose_step: 2.0,
+            clearance: 3.0,
+            waypoint_spacing: None,
+        }
+    }
+}
+
+impl CaseConfig {
+    /// The paper's setting: a 150 x 150 disaster area explored by 2 robots with 16-beam
+    /// infrared rings (range 30 cells), range noise bounds 10 % and 15 %, overlap 0.5.
+    pub fn paper() -> Self {
+        Self {
+            world: WorldConfig {
+                width: 150,
+                height: 150,
+                ..WorldConfig::default()
+            },
+            robots: vec![RobotConfig::infrared(0.10), RobotConfig::infrared(0.15)],
+            margin: 4,
+            extra_margin: 10,
+            ..Self::default()
+        }
+    }
+
+    /// A structured indoor floor of `size x size` cells with two lidar robots.
+    pub fn indoor(size: usize) -> Self {
+        Self {
+            world: WorldConfig {
+                kind: WorldKind::Indoor,
+                width: size,
+                height: size,
+                ..WorldConfig::default()
+            },
+            ..Self::default()
+        }
+    }
+
+    /// Check every field; generation calls this first.
+    pub fn validate(&self) -> Result<()> {
+        let bad = |m: String| Err(Error::Config(m));
+        if !(2..=32).contains(&self.robots.len()) {
+            return bad(format!("{} robots (need 2..=32)", self.robots.len()));
+        }
+        for (i, r) in self.robots.iter().enumerate() {
+            if !(1..=100_000).contains(&r.beams) {
+                return bad(format!("robot {i}: {} beams (need 1..=100000)", r.beams));
+            }
+            if !(r.max_range.is_finite() && r.max_range >= 2.0) {
+                return bad(format!("robot {i}: max_range {} (need >= 2)", r.max_range));
+            }
+            if !(0.0..0.9).contains(&r.noise_bound) {
+                return bad(format!(
+                    "robot {i}: noise_bound {} (need 0..0.9)",
+                    r.noise_bound
+                ));
+            }
+            if !(0.0..1.0).contains(&r.dropout) {
+                return bad(format!("robot {i}: dropout {} (need 0..1)", r.dropout));
+            }
+            if let Some(j) = r.failed_beams.iter().find(|&&j| j >= r.beams) {
+                return bad(format!("robot {i}: failed beam {j} >= {} beams", r.beams));
+            }
+            if (0..r.beams).all(|j| r.failed_beams.contains(&j)) {
+                return bad(format!("robot {i}: every beam failed"));
+            }
+        }
+        if !(0.0..=1.0).contains(&self.overlap) {
+            return bad(format!("overlap {} (need 0..=1)", self.overlap));
+        }
+        if self.overlap_tolerance.is_nan() || self.overlap_tolerance < 0.0 {
+            return bad(format!("overlap_tolerance {}", self.overlap_tolerance));
+        }
+        if !(self.max_rotation.is_finite() && self.max_rotation >= 0.0) {
+            return bad(format!("max_rotation {}", self.max_rotation));
+        }
+        if !(self.pose_step.is_finite() && self.pose_step >= 0.25) {
+            return bad(format!("pose_step {} (need >= 0.25)", self.pose_step));
+        }
+        if !(self.clearance.is_finite() && (0.5..=200.0).contains(&self.clearance)) {
+            return bad(format!("clearance {} (need 0.5..=200)", self.clearance));
+        }
+        if let Some(s) = self.waypoint_spacing
+            && !(s.is_finite() && s >= 2.0)
+        {
+            return bad(format!("waypoint_spacing {s} (need >= 2)"));
+        }
+        Ok(())
+    }
+}
+
+/// One robot's result.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RobotMap {
+    /// The partial map in the robot's own frame (origin at zero, the world's resolution).
+    pub map: OccupancyGrid,
+    /// Maps a pixel of [`Self::map`] to a pixel of the world raster.
+    pub map_to_world: Rigid2,
+    /// The robot's poses in world pixels, in driving order.
+    pub path: Vec<DVec2>,
+}
+
+impl RobotMap {
+    /// The path in the robot's map pixels.
+    pub fn path_in_map(&self) -> Vec<DVec2> {
+        let inv = self.map_to_world.inverse();
+        self.path.iter().map(|&p| inv.apply(p)).collect()
+    }
+}
+
+/// A generated case: the world, each robot's map with its pose, and the overlaps.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Case {
+    /// The seed it was generated from.
+    pub seed: u64,
+    /// The configuration it was generated from.
+    pub config: CaseConfig,
+    /// The world (obstacle raster).
+    pub world: World,
+    /// One map per robot, in the order of `config.robots`.
+    pub robots: Vec<RobotMap>,
+    /// Achieved overlap: the mean over consecutive robots `(i, i + 1)` of
+    /// `|E_i & E_j| / min(|E_i|, |E_j|)`, `E` being the world cells a map knows.
+    pub achieved_overlap: f64,
+    /// The pairwise overlap matrix (diagonal 1).
+    pub overlaps: Vec<Vec<f64>>,
+}
+
+impl Case {
+    /// The transform mapping a pixel of map `j` onto the same place in map `i`.
+    ///
+    /// Panics if `i` or `j` is not a robot index, like slice indexing.
+    pub fn truth(&self, i: usize, j: usize) -> Rigid2 {
+        self.robots[i]
+            .map_to_world
+            .inverse()
+            .compose(&self.robots[j].map_to_world)
+    }
+
+    /// Number of world cells known in map `i`.
+    pub fn explored_cells(&self, i: usize) -> usize {
+        explored_masks(&self.world, &self.robots)
+            .iter()
+            .filter(|&&m| m & (1 << i) != 0)
+            .count()
+    }
+}
+
+/// Per world cell, a bitmask of the robots whose map knows it.
+fn explored_masks(world: &World, robots: &[RobotMap]) -> Vec<u32> {
+    let w = world.width();
+    let mut masks = vec![0u32; w * world.height()];
+    masks.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+        for (i, r) in robots.iter().enumerate() {
+            let inv = r.map_to_world.inverse();
+            for (x, m) in row.iter_mut().enumerate() {
+                let p = inv.apply(DVec2::new(x as f64, y as f64)).round();
+                if p.x >= 0.0
+                    && p.y >= 0.0
+                    && r.map
+                        .get(p.x as usize, p.y as usize)
+                        .is_some_and(|c| c != UNKNOWN)
+                {
+                    *m |= 1 << i;
+                }
+            }
+        }
+    });
+    masks
+}
+
+/// RNG streams, so that changing one stage's consumption never shifts another's numbers.
+const STREAM_WORLD: u64 = 1;
+const STREAM_TOUR: u64 = 2;
+const STREAM_ROBOT: u64 = 100;
+
+fn rng(seed: u64, stream: u64) -> ChaCha8Rng {
+    let mut r = ChaCha8Rng::seed_from_u64(seed);
+    r.set_stream(stream);
+    r
+}
+
+/// Generate a case: world, tour, overlap-controlled robot segments, maps with truth.
+pub fn generate_case(config: &CaseConfig, seed: u64) -> Result<Case> {
+    config.validate()?;
+    let world = World::generate(&config.world, &mut rng(seed, STREAM_WORLD))?;
+    let n = config.robots.len();
+    let min_range = config
+        .robots
+        .iter()
+        .map(|r| r.max_range)
+        .fold(f64::INFINITY, f64::min);
+    let spacing = config.waypoint_spacing.unwrap_or(0.8 * min_range);
+    let tour = planner::tour(
+        &world,
+        config.clearance,
+        spacing,
+        config.pose_step,
+        &mut rng(seed, STREAM_TOUR),
+    )?;
+    let len = tour.len();
+    if len < 4 * n {
+        return Err(Error::NoFreeSpace);
+    }
+
+    // Overlap control on noise-free footprints.
+    let seg_len = (len / n) as i64;
+    let (lo, hi) = if n == 2 {
+        (-(seg_len * 6 / 10), len as i64)
+    } else {
+        (-(seg_len * 3 / 10), len as i64)
+    };
+    let raster = overlap::CoarseRaster::new(&world);
+    let fps: Vec<_> = config
+        .robots
+        .iter()
+        .enumerate()
+        .map(|(i, r)| {
+            let window = overlap::segment(i, n, len, hi);
+            overlap::footprints(&world, &tour, window, r, i % 2 == 1, raster)
+        })
+        .collect();
+    let mut masks = Vec::new();
+    let mut eval = |d: i64| overlap::reference_overlap(&fps, len, d, &mut masks, raster);
+    let safety = (0.25 * min_range / config.pose_step).ceil() as i64;
+    let delta = overlap::choose_delta(&mut eval, config.overlap, lo, hi, safety);
+
+    let mut robots = Vec::with_capacity(n);
+    for (i, rc) in config.robots.iter().enumerate() {
+        let mut poses: Vec<_> = tour[overlap::segment(i, n, len, delta)].to_vec();
+        if i % 2 == 1 {
+            // Odd robots drive the tour backwards, so neighbours start far apart.
+            poses.reverse();
+            for p in &mut poses {
+                p.heading += PI;
+            }
+        }
+        let mut r = rng(seed, STREAM_ROBOT + i as u64);
+        let rays = sensor::measure(&world, &poses, rc, &mut r);
+        let (map, map_to_world) =
+            sensor::build_map(&rays, &poses, config, world.resolution(), &mut r)?;
+        robots.push(RobotMap {
+            map,
+            map_to_world,
+            path: poses.iter().map(|p| p.pos).collect(),
+        });
+    }
+    let overlaps = overlap::overlap_matrix(&explored_masks(&world, &robots), n);
+    let achieved = overlap::mean_consecutive(&overlaps);
+    if (achieved - config.overlap).abs() > config.overlap_tolerance {
+        return Err(Error::OverlapMissed {
+            requested: config.overlap,
+            achieved,
+            tolerance: config.overlap_tolerance,
+        });
+    }
+    Ok(Case {
+        seed,
+        config: config.clone(),
+        world,
+        robots,
+        achieved_overlap: achieved,
+        overlaps,
+    })
+}

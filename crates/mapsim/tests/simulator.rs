@@ -1,0 +1,176 @@
+//! The simulator's promises: determinism, overlap control, truth that makes the maps agree,
+//! and the paper's preset.
+
+use grid_core::metrics::agreement;
+use mapsim::{CaseConfig, RobotConfig, generate_case};
+
+#[test]
+fn same_seed_same_maps() {
+    let config = CaseConfig::paper();
+    let a = generate_case(&config, 7).unwrap();
+    let b = generate_case(&config, 7).unwrap();
+    for (ra, rb) in a.robots.iter().zip(&b.robots) {
+        assert_eq!(ra.map, rb.map);
+        assert_eq!(ra.map_to_world, rb.map_to_world);
+    }
+    let c = generate_case(&config, 8).unwrap();
+    assert_ne!(
+        a.robots[0].map, c.robots[0].map,
+        "another seed gives another case"
+    );
+}
+
+#[test]
+fn achieved_overlap_is_close_to_the_requested_one() {
+    for overlap in [0.3, 0.5, 0.7] {
+        for seed in 0..4 {
+            let config = CaseConfig {
+                overlap,
+                overlap_tolerance: f64::INFINITY,
+                ..CaseConfig::default()
+            };
+            let case = generate_case(&config, seed).unwrap();
+            let err = (case.achieved_overlap - overlap).abs();
+            assert!(
+                err <= 0.1,
+                "requested {overlap}, achieved {} (seed {seed})",
+                case.achieved_overlap
+            );
+        }
+    }
+}
+
+#[test]
+fn zero_overlap_gives_disjoint_explored_areas() {
+    let config = CaseConfig {
+        overlap: 0.0,
+        overlap_tolerance: f64::INFINITY,
+        ..CaseConfig::default()
+    };
+    for seed in 0..3 {
+        let case = generate_case(&config, seed).unwrap();
+        assert!(
+            case.achieved_overlap <= 0.02,
+            "seed {seed}: {}",
+            case.achieved_overlap
+        );
+    }
+}
+
+/// Mean acceptance index of map 1 warped onto map 0 with the truth, over a few seeds.
+fn mean_acceptance(noise: f64) -> f64 {
+    let mut sum = 0.0;
+    for seed in 0..4 {
+        let config = CaseConfig {
+            world: mapsim::WorldConfig {
+                width: 250,
+                height: 250,
+                ..Default::default()
+            },
+            robots: vec![
+                RobotConfig {
+                    noise_bound: noise,
+                    max_range: 60.0,
+                    ..RobotConfig::default()
+                };
+                2
+            ],
+            overlap_tolerance: f64::INFINITY,
+            ..CaseConfig::default()
+        };
+        let case = generate_case(&config, seed).unwrap();
+        let ag = agreement(&case.robots[0].map, &case.robots[1].map, &case.truth(0, 1));
+        sum += ag.acceptance_index().unwrap();
+    }
+    sum / 4.0
+}
+
+/// Mean share of map 1's occupied cells that land on an occupied cell of map 0 (where map 0
+/// knows the cell), over a few seeds: how well the walls agree.
+fn mean_wall_agreement(noise: f64) -> f64 {
+    use grid_core::{CellState, DVec2};
+    let mut sum = 0.0;
+    for seed in 0..4 {
+        let config = CaseConfig {
+            world: mapsim::WorldConfig {
+                width: 250,
+                height: 250,
+                ..Default::default()
+            },
+            robots: vec![
+                RobotConfig {
+                    noise_bound: noise,
+                    max_range: 60.0,
+                    ..RobotConfig::default()
+                };
+                2
+            ],
+            overlap_tolerance: f64::INFINITY,
+            ..CaseConfig::default()
+        };
+        let case = generate_case(&config, seed).unwrap();
+        let (a, b, t) = (&case.robots[0].map, &case.robots[1].map, case.truth(0, 1));
+        let (mut hit, mut n) = (0usize, 0usize);
+        for y in 0..b.height() {
+            for x in 0..b.width() {
+                if b.state(x, y) != CellState::Occupied {
+                    continue;
+                }
+                let q = t.apply(DVec2::new(x as f64, y as f64)).round();
+                if q.x < 0.0 || q.y < 0.0 {
+                    continue;
+                }
+                match a.state(q.x as usize, q.y as usize) {
+                    CellState::Unknown => {}
+                    CellState::Occupied => (hit, n) = (hit + 1, n + 1),
+                    CellState::Free => n += 1,
+                }
+            }
+        }
+        sum += hit as f64 / n.max(1) as f64;
+    }
+    sum / 4.0
+}
+
+#[test]
+fn truth_makes_the_maps_agree_and_noise_lowers_agreement() {
+    // The acceptance index counts free cells too, and free space dominates; so the drop with
+    // noise is small, and above about 30 % it flattens (noisy hits are overwritten by the
+    // free space of later beams). The walls tell the noise apart.
+    let clean = mean_acceptance(0.0);
+    assert!(clean >= 0.97, "noise-free robots: acceptance index {clean}");
+    assert!(
+        mean_acceptance(0.3) < clean,
+        "30 % noise lowers the acceptance index"
+    );
+    let walls: Vec<f64> = [0.0, 0.1, 0.3]
+        .into_iter()
+        .map(mean_wall_agreement)
+        .collect();
+    assert!(
+        walls[0] > walls[1] && walls[1] > walls[2],
+        "wall agreement by noise 0/10/30 %: {walls:?}"
+    );
+}
+
+#[test]
+fn truth_is_consistent_both_ways() {
+    let case = generate_case(&CaseConfig::default(), 3).unwrap();
+    let round = case.truth(0, 1).compose(&case.truth(1, 0));
+    assert!(
+        round.theta.abs() < 1e-9 && round.tx.abs() < 1e-6 && round.ty.abs() < 1e-6,
+        "{round:?}"
+    );
+}
+
+#[test]
+fn paper_preset_reproduces_its_setting() {
+    let config = CaseConfig::paper();
+    assert_eq!((config.world.width, config.world.height), (150, 150));
+    assert_eq!(config.robots.len(), 2);
+    assert!(config.robots.iter().all(|r| r.beams == 16));
+    assert_eq!(config.robots[0].noise_bound, 0.10);
+    assert_eq!(config.robots[1].noise_bound, 0.15);
+    let case = generate_case(&config, 1).unwrap();
+    assert_eq!(case.world.width(), 150);
+}

@@ -1,0 +1,375 @@
+//! `cargo xtask eval`: accuracy, decline rate and time of registration on suites anyone can
+//! regenerate from a seed.
+//!
+//! Each suite is a family of simulated two-robot cases (mapsim) with known truth. A case is a
+//! success when the pair is accepted and the displacement error (mean over B's known cells of
+//! `|T_est(p) - T_true(p)|`) is at most 3 px, as the project's conventions define; in the
+//! zero-overlap suite, a success is a decline.
+
+use std::fmt::Write as _;
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use grid_core::metrics::{displacement_error, rotation_error_deg};
+use indicatif::{ProgressBar, ProgressStyle};
+use mapmerge::refine::refine;
+use mapmerge::verify::{PreparedMap, verify};
+use mapmerge::{Method, RegisterConfig, register};
+use mapsim::{CaseConfig, RobotConfig, WorldConfig, WorldKind, generate_case};
+use rayon::prelude::*;
+
+/// Arguments of `cargo xtask eval`.
+#[derive(Debug, clap::Args)]
+pub struct EvalArgs {
+    /// Suites to run (comma separated): overlap, zero, noise, mismatch, paper, real, or `all`.
+    #[arg(long, value_delimiter = ',', default_value = "overlap,zero")]
+    suites: Vec<String>,
+    /// Cases per suite row.
+    #[arg(long, default_value_t = 20)]
+    cases: usize,
+    /// Base seed: case k of a row uses seed `seed * 1_000_000 + row * 1000 + k`.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Registration methods to compare (comma separated): sift, blobs, hybrid.
+    #[arg(long, value_delimiter = ',', default_value = "hybrid")]
+    methods: Vec<Method>,
+    /// Also write the table (Markdown) and every case (JSON lines) under this path prefix:
+    /// PREFIX.md and PREFIX.jsonl.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// World size in cells for the simulated suites.
+    #[arg(long, default_value_t = 400)]
+    size: usize,
+}
+
+/// One row of a suite: a configuration and whether success means declining.
+struct Row {
+    suite: &'static str,
+    label: String,
+    config: CaseConfig,
+    expect_decline: bool,
+}
+
+fn lidar(noise: f64) -> RobotConfig {
+    RobotConfig {
+        noise_bound: noise,
+        ..RobotConfig::default()
+    }
+}
+
+fn world(kind: WorldKind, size: usize) -> WorldConfig {
+    WorldConfig {
+        kind,
+        width: size,
+        height: size,
+        ..WorldConfig::default()
+    }
+}
+
+fn case(world: WorldConfig, robots: Vec<RobotConfig>, overlap: f64) -> CaseConfig {
+    CaseConfig {
+        world,
+        robots,
+        overlap,
+        overlap_tolerance: f64::INFINITY,
+        ..CaseConfig::default()
+    }
+}
+
+fn rows(suites: &[String], size: usize) -> Result<Vec<Row>> {
+    let all = suites.iter().any(|s| s == "all");
+    let want = |name: &str| all || suites.iter().any(|s| s == name);
+    let kinds = [
+        ("disaster", WorldKind::Disaster),
+        ("indoor", WorldKind::Indoor),
+    ];
+    let mut rows = Vec::new();
+    if want("overlap") {
+        for (wname, kind) in &kinds {
+            for overlap in [0.3, 0.5, 0.7] {
+                rows.push(Row {
+                    suite: "overlap",
+                    label: format!("{wname}, overlap {overlap}, noise 10%/10%"),
+                    config: case(
+                        world(kind.clone(), size),
+                        vec![lidar(0.10), lidar(0.10)],
+                        overlap,
+                    ),
+                    expect_decline: false,
+                });
+            }
+        }
+    }
+    if want("zero") {
+        for (wname, kind) in &kinds {
+            rows.push(Row {
+                suite: "zero",
+                label: format!("{wname}, overlap 0 (must decline)"),
+                config: case(
+                    world(kind.clone(), size),
+                    vec![lidar(0.10), lidar(0.10)],
+                    0.0,
+                ),
+                expect_decline: true,
+            });
+        }
+    }
+    if want("noise") {
+        for noise in [0.1, 0.3, 0.5] {
+            rows.push(Row {
+                suite: "noise",
+                label: format!(
+                    "disaster, overlap 0.5, noise {0:.0}%/{0:.0}%",
+                    noise * 100.0
+                ),
+                config: case(
+                    world(WorldKind::Disaster, size),
+                    vec![lidar(noise), lidar(noise)],
+                    0.5,
+                ),
+                expect_decline: false,
+            });
+        }
+    }
+    if want("mismatch") {
+        for noise_b in [0.15, 0.2, 0.3, 0.5] {
+            rows.push(Row {
+                suite: "mismatch",
+                label: format!("disaster, overlap 0.5, noise 10%/{:.0}%", noise_b * 100.0),
+                config: case(
+                    world(WorldKind::Disaster, size),
+                    vec![lidar(0.10), lidar(noise_b)],
+                    0.5,
+                ),
+                expect_decline: false,
+            });
+        }
+    }
+    if want("paper") {
+        let mut config = CaseConfig::paper();
+        config.overlap_tolerance = f64::INFINITY;
+        rows.push(Row {
+            suite: "paper",
+            label: "paper preset: 150x150, 16 IR beams, noise 10%/15%".into(),
+            config,
+            expect_decline: false,
+        });
+    }
+    if want("real") {
+        let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../fixtures/maps");
+        for name in ["wpi_ilab", "aws_small_house", "uos_cic", "intel_lab"] {
+            let dir = root.join(name);
+            let yaml = dir.join(format!("{name}.yaml"));
+            let grid = grid_core::io::load_map(&yaml, &grid_core::io::LoadOptions::default())
+                .with_context(|| format!("loading {}", yaml.display()))?;
+            rows.push(Row {
+                suite: "real",
+                label: format!("{name} world, overlap 0.5, noise 10%/20%"),
+                config: case(
+                    world(WorldKind::Grid(grid), 0),
+                    vec![lidar(0.10), lidar(0.20)],
+                    0.5,
+                ),
+                expect_decline: false,
+            });
+        }
+    }
+    anyhow::ensure!(!rows.is_empty(), "no known suite in {suites:?}");
+    Ok(rows)
+}
+
+/// The outcome of one case.
+#[derive(Debug, serde::Serialize)]
+struct Outcome {
+    suite: &'static str,
+    row: String,
+    method: String,
+    seed: u64,
+    achieved_overlap: f64,
+    accepted: bool,
+    rotation_error_deg: Option<f64>,
+    displacement_error_px: Option<f64>,
+    success: bool,
+    millis: f64,
+    error: Option<String>,
+    /// Scores of the best candidate (accepted or not), for calibrating the verification.
+    best: Option<mapmerge::Candidate>,
+    timings: Option<mapmerge::Timings>,
+    correspondences: Option<mapmerge::KindTotals>,
+    /// Scores of the true transform, and how far refinement started at the truth drifts
+    /// (displacement error in px): what the verification could reach at best.
+    truth_verification: Option<mapmerge::verify::Verification>,
+    truth_refined_drift_px: Option<f64>,
+}
+
+fn run_case(row: &Row, method: Method, seed: u64) -> Outcome {
+    let mut out = Outcome {
+        suite: row.suite,
+        row: row.label.clone(),
+        method: method.to_string(),
+        seed,
+        achieved_overlap: 0.0,
+        accepted: false,
+        rotation_error_deg: None,
+        displacement_error_px: None,
+        success: false,
+        millis: 0.0,
+        error: None,
+        best: None,
+        timings: None,
+        correspondences: None,
+        truth_verification: None,
+        truth_refined_drift_px: None,
+    };
+    let case = match generate_case(&row.config, seed) {
+        Ok(c) => c,
+        Err(e) => {
+            out.error = Some(e.to_string());
+            return out;
+        }
+    };
+    out.achieved_overlap = case.achieved_overlap;
+    let (a, b) = (&case.robots[0].map, &case.robots[1].map);
+    let truth = case.truth(0, 1);
+    let config = RegisterConfig {
+        method,
+        ..RegisterConfig::default()
+    };
+    let t0 = Instant::now();
+    let result = match register(a, b, &config) {
+        Ok(r) => r,
+        Err(e) => {
+            out.error = Some(e.to_string());
+            return out;
+        }
+    };
+    out.millis = t0.elapsed().as_secs_f64() * 1e3;
+    if !row.expect_decline {
+        let vc = &config.pair.verify;
+        let (pa, pb) = (PreparedMap::new(a, vc), PreparedMap::new(b, vc));
+        out.truth_verification = Some(verify(&pa, &pb, &truth, vc));
+        let refined = refine(&pa, &pb, &truth, &config.pair.refine);
+        out.truth_refined_drift_px = displacement_error(b, &refined, &truth);
+    }
+    out.best = result.candidates.first().cloned();
+    out.timings = Some(result.timings);
+    out.correspondences = Some(result.correspondences);
+    if let Some(c) = &result.accepted {
+        out.accepted = true;
+        out.rotation_error_deg = Some(rotation_error_deg(&c.transform, &truth));
+        out.displacement_error_px = displacement_error(b, &c.transform, &truth);
+    }
+    out.success = if row.expect_decline {
+        !out.accepted
+    } else {
+        out.displacement_error_px.is_some_and(|d| d <= 3.0)
+    };
+    out
+}
+
+fn median(mut v: Vec<f64>) -> Option<f64> {
+    if v.is_empty() {
+        return None;
+    }
+    v.sort_by(f64::total_cmp);
+    Some(v[v.len() / 2])
+}
+
+fn fmt_opt(v: Option<f64>, digits: usize) -> String {
+    v.map_or("-".into(), |v| format!("{v:.digits$}"))
+}
+
+/// Run `cargo xtask eval`.
+pub fn run(args: EvalArgs) -> Result<()> {
+    let rows = rows(&args.suites, args.size)?;
+    let jobs: Vec<(usize, Method, u64)> = rows
+        .iter()
+        .enumerate()
+        .flat_map(|(r, _)| {
+            args.methods.iter().flat_map(move |&m| {
+                (0..args.cases as u64)
+                    .map(move |k| (r, m, args.seed * 1_000_000 + r as u64 * 1000 + k))
+            })
+        })
+        .collect();
+    let bar = ProgressBar::new(jobs.len() as u64);
+    bar.set_style(
+        ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} cases {msg}")
+            .expect("static template")
+            .progress_chars("=> "),
+    );
+    let outcomes: Vec<Outcome> = jobs
+        .par_iter()
+        .map(|&(r, m, seed)| {
+            let o = run_case(&rows[r], m, seed);
+            bar.inc(1);
+            o
+        })
+        .collect();
+    bar.finish_and_clear();
+
+    let mut table = String::new();
+    writeln!(
+        table,
+        "| suite | case family | method | cases | success | accepted | false accepts | median rot. err (deg) | median disp. err (px) | mean overlap | mean time (ms) |"
+    )?;
+    writeln!(table, "|---|---|---|---|---|---|---|---|---|---|---|")?;
+    for row in &rows {
+        for &m in &args.methods {
+            let os: Vec<&Outcome> = outcomes
+                .iter()
+                .filter(|o| o.row == row.label && o.method == m.to_string())
+                .collect();
+            let n = os.len().max(1) as f64;
+            let pct = |k: usize| format!("{:.0}%", 100.0 * k as f64 / n);
+            let success = os.iter().filter(|o| o.success).count();
+            let accepted = os.iter().filter(|o| o.accepted).count();
+            let false_acc = os
+                .iter()
+                .filter(|o| o.accepted && (row.expect_decline || !o.success))
+                .count();
+            let errors = os.iter().filter(|o| o.error.is_some()).count();
+            let rot = median(os.iter().filter_map(|o| o.rotation_error_deg).collect());
+            let disp = median(os.iter().filter_map(|o| o.displacement_error_px).collect());
+            let overlap = os.iter().map(|o| o.achieved_overlap).sum::<f64>() / n;
+            let time = os.iter().map(|o| o.millis).sum::<f64>() / n;
+            let cases = if errors > 0 {
+                format!("{} ({errors} failed to generate)", os.len())
+            } else {
+                os.len().to_string()
+            };
+            writeln!(
+                table,
+                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.2} | {:.0} |",
+                row.suite,
+                row.label,
+                m,
+                cases,
+                pct(success),
+                pct(accepted),
+                pct(false_acc),
+                fmt_opt(rot, 2),
+                fmt_opt(disp, 2),
+                overlap,
+                time
+            )?;
+        }
+    }
+    print!("{table}");
+    if let Some(prefix) = &args.out {
+        let md = prefix.with_extension("md");
+        let cmd = std::env::args().skip(1).collect::<Vec<_>>().join(" ");
+        std::fs::write(&md, format!("Command: `cargo xtask {cmd}`\n\n{table}"))
+            .with_context(|| format!("writing {}", md.display()))?;
+        let mut lines = String::new();
+        for o in &outcomes {
+            lines.push_str(&serde_json::to_string(o)?);
+            lines.push('\n');
+        }
+        let jl = prefix.with_extension("jsonl");
+        std::fs::write(&jl, lines).with_context(|| format!("writing {}", jl.display()))?;
+        eprintln!("wrote {} and {}", md.display(), jl.display());
+    }
+    Ok(())
+}

@@ -1,0 +1,333 @@
+//! `cargo xtask gen`: write simulated cases (robot maps as map_saver PGM + YAML, truth.json,
+//! preview.png) for evaluation and for looking at.
+
+use std::fs;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+use clap::ValueEnum;
+use grid_core::{CellState, DVec2, GridGeometry, OccupancyGrid, Pose2};
+use image::{Rgb, RgbImage};
+use indicatif::{ProgressBar, ProgressStyle};
+use mapsim::{Case, CaseConfig, WorldKind, generate_case};
+use serde_json::json;
+
+/// Base settings a case starts from before the individual flags apply.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Preset {
+    /// 150 x 150 disaster area, 2 robots, 16-beam infrared rings, noise 10 % / 15 %.
+    Paper,
+    /// 400 x 400 disaster area, 2 lidar robots.
+    Disaster,
+    /// 400 x 400 indoor floor, 2 lidar robots.
+    Indoor,
+}
+
+/// Flags of `cargo xtask gen`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Base settings.
+    #[arg(long, value_enum, default_value = "paper")]
+    preset: Preset,
+    /// Seed of the first case; case k uses seed + k.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Output directory (created); case k goes to OUT/case_<k>/.
+    #[arg(long, default_value = "target/sim")]
+    out: PathBuf,
+    /// Number of cases.
+    #[arg(long, default_value_t = 1)]
+    count: usize,
+    /// World side in cells (square world).
+    #[arg(long)]
+    size: Option<usize>,
+    /// Number of robots (extra robots copy the last robot's sensor).
+    #[arg(long)]
+    robots: Option<usize>,
+    /// Beams per robot.
+    #[arg(long)]
+    beams: Option<usize>,
+    /// Maximum range in cells.
+    #[arg(long)]
+    range: Option<f64>,
+    /// Range noise bounds, one per robot (the last one repeats), e.g. 0.1,0.15.
+    #[arg(long, value_delimiter = ',')]
+    noise: Option<Vec<f64>>,
+    /// Requested overlap fraction of the explored areas (0 = disjoint).
+    #[arg(long)]
+    overlap: Option<f64>,
+}
+
+/// The case config the flags describe.
+fn config(args: &Args) -> Result<CaseConfig> {
+    let mut c = match args.preset {
+        Preset::Paper => CaseConfig::paper(),
+        Preset::Disaster => CaseConfig::default(),
+        Preset::Indoor => CaseConfig::indoor(400),
+    };
+    if let Some(s) = args.size {
+        c.world.width = s;
+        c.world.height = s;
+    }
+    if let Some(n) = args.robots {
+        if n < 2 {
+            bail!("--robots {n}: need at least 2");
+        }
+        let last = c.robots.last().cloned().unwrap_or_default();
+        c.robots.resize(n, last);
+    }
+    for r in &mut c.robots {
+        if let Some(b) = args.beams {
+            r.beams = b;
+        }
+        if let Some(m) = args.range {
+            r.max_range = m;
+        }
+    }
+    if let Some(noise) = &args.noise {
+        if noise.is_empty() {
+            bail!("--noise needs at least one value");
+        }
+        for (i, r) in c.robots.iter_mut().enumerate() {
+            r.noise_bound = noise[i.min(noise.len() - 1)];
+        }
+    }
+    if let Some(o) = args.overlap {
+        c.overlap = o;
+    }
+    c.validate()?;
+    Ok(c)
+}
+
+/// Run the command.
+pub fn run(args: Args) -> Result<()> {
+    let config = config(&args)?;
+    fs::create_dir_all(&args.out).with_context(|| format!("{}", args.out.display()))?;
+    let bar = (args.count > 1).then(|| {
+        let b = ProgressBar::new(args.count as u64);
+        b.set_style(
+            ProgressStyle::with_template(
+                "{bar:40} {pos}/{len} cases, {elapsed} elapsed, eta {eta}",
+            )
+            .expect("static template"),
+        );
+        b
+    });
+    for k in 0..args.count {
+        let seed = args.seed + k as u64;
+        let case =
+            generate_case(&config, seed).with_context(|| format!("case {k} (seed {seed})"))?;
+        let dir = args.out.join(format!("case_{k}"));
+        write_case(&case, args.preset, &dir)?;
+        match &bar {
+            Some(b) => b.inc(1),
+            None => eprintln!(
+                "{}: {} robots, overlap {:.3} (requested {})",
+                dir.display(),
+                case.robots.len(),
+                case.achieved_overlap,
+                config.overlap
+            ),
+        }
+    }
+    if let Some(b) = bar {
+        b.finish();
+    }
+    Ok(())
+}
+
+/// Write `bytes` to `path` atomically (temporary file, then rename).
+fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let tmp = path.with_extension("tmp");
+    let mut f = fs::File::create(&tmp).with_context(|| format!("{}", tmp.display()))?;
+    f.write_all(bytes)
+        .and_then(|()| f.sync_all())
+        .with_context(|| format!("{}", tmp.display()))?;
+    fs::rename(&tmp, path).with_context(|| format!("{}", path.display()))?;
+    Ok(())
+}
+
+/// map_saver trinary PGM: 0 occupied, 254 free, 205 unknown. Written here because
+/// grid_core::io has no writer yet.
+fn pgm(map: &OccupancyGrid) -> Vec<u8> {
+    let mut out = format!("P5\n{} {}\n255\n", map.width(), map.height()).into_bytes();
+    out.extend(
+        map.cells()
+            .iter()
+            .map(|&c| match OccupancyGrid::classify(c) {
+                CellState::Occupied => 0u8,
+                CellState::Free => 254,
+                CellState::Unknown => 205,
+            }),
+    );
+    out
+}
+
+fn yaml(image: &str, map: &OccupancyGrid) -> String {
+    let o = map.origin();
+    format!(
+        "image: {image}\nmode: trinary\nresolution: {}\norigin: [{:?}, {:?}, {:?}]\nnegate: 0\n\
+         occupied_thresh: 0.65\nfree_thresh: 0.196\n",
+        map.resolution(),
+        o.x,
+        o.y,
+        o.yaw
+    )
+}
+
+fn write_case(case: &Case, preset: Preset, dir: &Path) -> Result<()> {
+    fs::create_dir_all(dir).with_context(|| format!("{}", dir.display()))?;
+    let world_geo = GridGeometry {
+        width: case.world.width(),
+        height: case.world.height(),
+        resolution: case.world.resolution(),
+        origin: Pose2::default(),
+    };
+    let mut robots = Vec::new();
+    for (i, r) in case.robots.iter().enumerate() {
+        let image = format!("robot_{i}.pgm");
+        write_atomic(&dir.join(&image), &pgm(&r.map))?;
+        write_atomic(
+            &dir.join(format!("robot_{i}.yaml")),
+            yaml(&image, &r.map).as_bytes(),
+        )?;
+        let pose = r.map_to_world.to_world(&world_geo, &r.map.geometry());
+        robots.push(json!({
+            "image": image,
+            "width": r.map.width(),
+            "height": r.map.height(),
+            "map_to_world": r.map_to_world,
+            "world_pose": {"x": pose.tx, "y": pose.ty, "yaw": pose.theta},
+            "path_poses": r.path.len(),
+        }));
+    }
+    let mut pairs = Vec::new();
+    for i in 0..case.robots.len() {
+        for j in 0..case.robots.len() {
+            if i != j {
+                pairs.push(json!({"a": i, "b": j, "transform": case.truth(i, j)}));
+            }
+        }
+    }
+    let c = &case.config;
+    let kind = match c.world.kind {
+        WorldKind::Disaster => "disaster",
+        WorldKind::Indoor => "indoor",
+        WorldKind::Grid(_) => "grid",
+    };
+    let truth = json!({
+        "seed": case.seed,
+        "preset": format!("{preset:?}").to_lowercase(),
+        "convention": "transform maps a pixel of map b onto map a (x column, y row from top); \
+                       map_to_world maps a map pixel to a world-raster pixel; world_pose is the \
+                       map frame in the world frame (metres, yaw ccw, world origin 0)",
+        "requested_overlap": c.overlap,
+        "achieved_overlap": case.achieved_overlap,
+        "overlaps": case.overlaps,
+        "world": {"kind": kind, "width": case.world.width(), "height": case.world.height(),
+                  "resolution": case.world.resolution(), "clutter": c.world.clutter},
+        "config": {
+            "robots": c.robots,
+            "overlap_tolerance": c.overlap_tolerance,
+            "max_rotation": c.max_rotation,
+            "margin": c.margin,
+            "extra_margin": c.extra_margin,
+            "pose_step": c.pose_step,
+            "clearance": c.clearance,
+            "waypoint_spacing": c.waypoint_spacing,
+        },
+        "robots": robots,
+        "pairs": pairs,
+    });
+    let mut text = serde_json::to_string_pretty(&truth)?;
+    text.push('\n');
+    write_atomic(&dir.join("truth.json"), text.as_bytes())?;
+    let mut png = Vec::new();
+    preview(case)
+        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .context("encoding preview.png")?;
+    write_atomic(&dir.join("preview.png"), &png)?;
+    Ok(())
+}
+
+const COLOURS: [[u8; 3]; 6] = [
+    [220, 40, 40],
+    [40, 90, 230],
+    [30, 160, 60],
+    [230, 140, 20],
+    [160, 50, 190],
+    [20, 170, 180],
+];
+
+/// The world with the robots' paths, then every robot's map with its path, side by side.
+fn preview(case: &Case) -> RgbImage {
+    let side = case.world.width().max(case.world.height());
+    // Integer scaling keeps single-cell walls crisp: up for small worlds, down for huge ones.
+    let (up, down) = if side < 300 {
+        (300_usize.div_ceil(side), 1)
+    } else {
+        (1, side.div_ceil(1200))
+    };
+    let scale = |v: usize| v * up / down;
+    let gap = 8;
+    let mut panels: Vec<RgbImage> = Vec::new();
+    let world = &case.world;
+    let mut wimg = RgbImage::from_fn(
+        scale(world.width()) as u32,
+        scale(world.height()) as u32,
+        |x, y| {
+            let (wx, wy) = (x as usize * down / up, y as usize * down / up);
+            if world.is_occupied(wx as i64, wy as i64) {
+                Rgb([0, 0, 0])
+            } else {
+                Rgb([255, 255, 255])
+            }
+        },
+    );
+    for (i, r) in case.robots.iter().enumerate() {
+        draw_path(&mut wimg, &r.path, COLOURS[i % COLOURS.len()], up, down);
+    }
+    panels.push(wimg);
+    for (i, r) in case.robots.iter().enumerate() {
+        let m = &r.map;
+        let mut img =
+            RgbImage::from_fn(scale(m.width()) as u32, scale(m.height()) as u32, |x, y| {
+                let (mx, my) = (x as usize * down / up, y as usize * down / up);
+                let v = match m.state(mx, my) {
+                    CellState::Occupied => 0,
+                    CellState::Free => 254,
+                    CellState::Unknown => 205,
+                };
+                Rgb([v, v, v])
+            });
+        draw_path(
+            &mut img,
+            &r.path_in_map(),
+            COLOURS[i % COLOURS.len()],
+            up,
+            down,
+        );
+        panels.push(img);
+    }
+    let w: u32 = panels.iter().map(|p| p.width()).sum::<u32>() + gap * (panels.len() as u32 + 1);
+    let h = panels.iter().map(|p| p.height()).max().unwrap_or(1) + 2 * gap;
+    let mut out = RgbImage::from_pixel(w, h, Rgb([60, 60, 60]));
+    let mut x0 = gap;
+    for p in &panels {
+        image::imageops::replace(&mut out, p, x0 as i64, gap as i64);
+        x0 += p.width() + gap;
+    }
+    out
+}
+
+fn draw_path(img: &mut RgbImage, path: &[DVec2], colour: [u8; 3], up: usize, down: usize) {
+    let f = up as f64 / down as f64;
+    for p in path {
+        let q = (*p + DVec2::splat(0.5)) * f;
+        let (x, y) = (q.x as i64, q.y as i64);
+        if x >= 0 && y >= 0 && (x as u32) < img.width() && (y as u32) < img.height() {
+            img.put_pixel(x as u32, y as u32, Rgb(colour));
+        }
+    }
+}
