@@ -1,0 +1,67 @@
+//! End-to-end registration of a 2048 x 2048 real-building pair, and each stage on its own.
+//!
+//! A = the Osnabrueck CIC floor (fixtures/maps/uos_cic, 980 x 1477) on a 2048 x 2048 canvas,
+//! B = the same floor turned by 30 degrees and shifted, on another 2048 x 2048 canvas.
+//! Run: `cargo bench -p mapmerge --bench register`.
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use grid_core::io::{LoadOptions, load_map};
+use grid_core::{CorrespondenceSource, OccupancyGrid, Rigid2};
+use mapmerge::verify::{PreparedMap, VerifyConfig};
+use mapmerge::{RegisterConfig, register};
+
+fn pair() -> (OccupancyGrid, OccupancyGrid) {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../fixtures/maps/uos_cic/uos_cic.yaml"
+    );
+    let map = load_map(path, &LoadOptions::default()).expect("fixture loads");
+    let a = map
+        .warp(&Rigid2::new(0.0, 500.0, 280.0), 2048, 2048)
+        .expect("canvas");
+    let b = map
+        .warp(&Rigid2::new(30f64.to_radians(), 900.0, 150.0), 2048, 2048)
+        .expect("canvas");
+    (a, b)
+}
+
+fn bench(c: &mut Criterion) {
+    let (a, b) = pair();
+    let config = RegisterConfig::default();
+    let mut g = c.benchmark_group("register_2048");
+    g.sample_size(10);
+    g.bench_function("end_to_end", |bn| {
+        bn.iter(|| register(&a, &b, &config).expect("valid config"))
+    });
+    let sift = sift_desc::SiftCorrespondences::new(config.sift.clone()).expect("valid config");
+    g.bench_function("sift_correspondences", |bn| {
+        bn.iter(|| {
+            let mut out = Vec::new();
+            sift.correspondences(&a, &b, &mut out);
+            out
+        })
+    });
+    let blobs = blob_features::BlobCorrespondences {
+        blobs: blob_features::Blobs::new(config.blobs),
+        matching: config.blob_matching,
+    };
+    g.bench_function("blob_correspondences", |bn| {
+        bn.iter(|| {
+            let mut out = Vec::new();
+            blobs.correspondences(&a, &b, &mut out);
+            out
+        })
+    });
+    g.bench_function("prepare_both_maps", |bn| {
+        bn.iter(|| {
+            (
+                PreparedMap::new(&a, &VerifyConfig::default()).known_cells,
+                PreparedMap::new(&b, &VerifyConfig::default()).known_cells,
+            )
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
