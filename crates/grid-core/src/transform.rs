@@ -90,22 +90,22 @@ impl Rigid2 {
     /// Both maps must have the same resolution for the result to be rigid; with different
     /// resolutions the caller must rescale B first.
     pub fn to_world(&self, a: &GridGeometry, b: &GridGeometry) -> Self {
-        // A world map frame point w_b -> B pixel -> A pixel -> A world. The map is affine;
-        // read it off by applying it to the origin and the two unit vectors.
-        let f = |w: DVec2| a.pixel_to_world(self.apply(b.world_to_pixel(w)));
-        let o = f(DVec2::ZERO);
-        let ex = f(DVec2::X) - o;
-        Self {
-            theta: wrap_angle(ex.y.atan2(ex.x)),
-            tx: o.x,
-            ty: o.y,
-        }
+        // A world map frame point w_b -> B pixel -> A pixel -> A world: rigid, since the two
+        // reflections (y down in pixels, up in the world) cancel.
+        Self::from_rigid_map(|w| a.pixel_to_world(self.apply(b.world_to_pixel(w))))
     }
 
     /// The inverse of [`Self::to_world`]: a pose of B's map frame in A's map frame turned into
     /// the pixel transform from B's pixels to A's pixels.
     pub fn from_world(world: &Self, a: &GridGeometry, b: &GridGeometry) -> Self {
-        let f = |p: DVec2| a.world_to_pixel(world.apply(b.pixel_to_world(p)));
+        Self::from_rigid_map(|p| a.world_to_pixel(world.apply(b.pixel_to_world(p))))
+    }
+}
+
+impl Rigid2 {
+    /// Read a rigid transform off a map known to be rigid, from where it sends the origin and
+    /// the unit x vector.
+    fn from_rigid_map(f: impl Fn(DVec2) -> DVec2) -> Self {
         let o = f(DVec2::ZERO);
         let ex = f(DVec2::X) - o;
         Self {

@@ -57,28 +57,33 @@ fn zero_overlap_gives_disjoint_explored_areas() {
     }
 }
 
+/// A 250 x 250 disaster case with two lidars of the given noise bound.
+fn lidar_case(noise: f64, seed: u64) -> mapsim::Case {
+    let config = CaseConfig {
+        world: mapsim::WorldConfig {
+            width: 250,
+            height: 250,
+            ..Default::default()
+        },
+        robots: vec![
+            RobotConfig {
+                noise_bound: noise,
+                max_range: 60.0,
+                ..RobotConfig::default()
+            };
+            2
+        ],
+        overlap_tolerance: f64::INFINITY,
+        ..CaseConfig::default()
+    };
+    generate_case(&config, seed).unwrap()
+}
+
 /// Mean acceptance index of map 1 warped onto map 0 with the truth, over a few seeds.
 fn mean_acceptance(noise: f64) -> f64 {
     let mut sum = 0.0;
     for seed in 0..4 {
-        let config = CaseConfig {
-            world: mapsim::WorldConfig {
-                width: 250,
-                height: 250,
-                ..Default::default()
-            },
-            robots: vec![
-                RobotConfig {
-                    noise_bound: noise,
-                    max_range: 60.0,
-                    ..RobotConfig::default()
-                };
-                2
-            ],
-            overlap_tolerance: f64::INFINITY,
-            ..CaseConfig::default()
-        };
-        let case = generate_case(&config, seed).unwrap();
+        let case = lidar_case(noise, seed);
         let ag = agreement(&case.robots[0].map, &case.robots[1].map, &case.truth(0, 1));
         sum += ag.acceptance_index().unwrap();
     }
@@ -91,24 +96,7 @@ fn mean_wall_agreement(noise: f64) -> f64 {
     use grid_core::{CellState, DVec2};
     let mut sum = 0.0;
     for seed in 0..4 {
-        let config = CaseConfig {
-            world: mapsim::WorldConfig {
-                width: 250,
-                height: 250,
-                ..Default::default()
-            },
-            robots: vec![
-                RobotConfig {
-                    noise_bound: noise,
-                    max_range: 60.0,
-                    ..RobotConfig::default()
-                };
-                2
-            ],
-            overlap_tolerance: f64::INFINITY,
-            ..CaseConfig::default()
-        };
-        let case = generate_case(&config, seed).unwrap();
+        let case = lidar_case(noise, seed);
         let (a, b, t) = (&case.robots[0].map, &case.robots[1].map, case.truth(0, 1));
         let (mut hit, mut n) = (0usize, 0usize);
         for y in 0..b.height() {
