@@ -212,3 +212,31 @@ fn debug_png_is_written() {
         "no temporary file left"
     );
 }
+
+#[test]
+fn registers_from_area_evidence_alone() {
+    // Obstacle components only, no SIFT and no global search: each component match proposes a
+    // full rigid hypothesis (1-point RANSAC), which must reach the truth on a real map.
+    use grid_core::CorrespondenceSource;
+    use mapmerge::{PairConfig, register_with};
+    let dir = TempDir::new().unwrap();
+    let a = load_map(fixture("wpi_ilab"), &LoadOptions::default()).unwrap();
+    let (b_path, truth) = rotated_crop(&dir, &a, 71.0, 200, DVec2::new(3.4, 2.2));
+    let b = load_map(&b_path, &LoadOptions::default()).unwrap();
+    let blobs = blob_features::BlobCorrespondences {
+        blobs: blob_features::Blobs::new(blob_features::BlobConfig::default()),
+        matching: blob_features::MatchConfig::default(),
+    };
+    let sources: [&dyn CorrespondenceSource; 1] = [&blobs];
+    let config = PairConfig {
+        global: None,
+        ..PairConfig::default()
+    };
+    let r = register_with(&a, &b, &sources, &config);
+    let c = r.accepted.expect("accepted from blob evidence");
+    assert_eq!(c.origin, "ransac");
+    assert_eq!(r.correspondences.intensity, 0);
+    assert!(r.inliers.area >= 2, "{:?}", r.inliers);
+    assert!(rotation_error_deg(&c.transform, &truth) < 0.5);
+    assert!(displacement_error(&b, &c.transform, &truth).unwrap() < 1.0);
+}
