@@ -143,6 +143,8 @@ proptest! {
             .collect();
         prop_assert!(expected.len() >= 30);
         prop_assert_eq!(&r.inliers, &expected);
+        // The refit is exact only when the inliers are exactly the true correspondences.
+        prop_assume!(expected.len() == 30);
         prop_assert!(angle_err_deg(&r.model, &truth) < 1e-9);
         prop_assert!((r.model.tx - truth.tx).abs() < 1e-7 && (r.model.ty - truth.ty).abs() < 1e-7, "{:?}", r.model);
     }
