@@ -2,12 +2,11 @@
 //! preview.png) for evaluation and for looking at.
 
 use std::fs;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use clap::ValueEnum;
-use grid_core::{CellState, DVec2, GridGeometry, OccupancyGrid, Pose2};
+use grid_core::{CellState, DVec2, GridGeometry, Pose2};
 use image::{Rgb, RgbImage};
 use indicatif::{ProgressBar, ProgressStyle};
 use mapsim::{Case, CaseConfig, WorldKind, generate_case};
@@ -57,6 +56,17 @@ pub struct Args {
     /// Requested overlap fraction of the explored areas (0 = disjoint).
     #[arg(long)]
     overlap: Option<f64>,
+    /// Probability that a beam returns nothing, one per robot (the last one repeats).
+    #[arg(long, value_delimiter = ',')]
+    dropout: Option<Vec<f64>>,
+    /// Indices of failed beams (never return a reading) of the LAST robot, e.g. 0,1,2,3: the
+    /// paper's "failed sensor" robot.
+    #[arg(long, value_delimiter = ',')]
+    failed_beams: Option<Vec<usize>>,
+    /// A real map (map_server YAML, or a PGM/PNG image) to explore instead of a generated
+    /// world: its free cells are free space, everything else is obstacle. Overrides --size.
+    #[arg(long, value_name = "MAP")]
+    world: Option<PathBuf>,
 }
 
 /// The case config the flags describe.
@@ -93,8 +103,27 @@ fn config(args: &Args) -> Result<CaseConfig> {
             r.noise_bound = noise[i.min(noise.len() - 1)];
         }
     }
+    if let Some(dropout) = &args.dropout {
+        if dropout.is_empty() {
+            bail!("--dropout needs at least one value");
+        }
+        for (i, r) in c.robots.iter_mut().enumerate() {
+            r.dropout = dropout[i.min(dropout.len() - 1)];
+        }
+    }
+    if let Some(failed) = &args.failed_beams
+        && let Some(last) = c.robots.last_mut()
+    {
+        last.failed_beams = failed.clone();
+    }
     if let Some(o) = args.overlap {
         c.overlap = o;
+    }
+    if let Some(path) = &args.world {
+        let grid = grid_core::io::load_map(path, &grid_core::io::LoadOptions::default())
+            .with_context(|| format!("--world {}", path.display()))?;
+        c.world.resolution = grid.resolution();
+        c.world.kind = WorldKind::Grid(grid);
     }
     c.validate()?;
     Ok(c)
@@ -137,45 +166,6 @@ pub fn run(args: Args) -> Result<()> {
     Ok(())
 }
 
-/// Write `bytes` to `path` atomically (temporary file, then rename).
-fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let tmp = path.with_extension("tmp");
-    let mut f = fs::File::create(&tmp).with_context(|| format!("{}", tmp.display()))?;
-    f.write_all(bytes)
-        .and_then(|()| f.sync_all())
-        .with_context(|| format!("{}", tmp.display()))?;
-    fs::rename(&tmp, path).with_context(|| format!("{}", path.display()))?;
-    Ok(())
-}
-
-/// map_saver trinary PGM: 0 occupied, 254 free, 205 unknown. Written here because
-/// grid_core::io has no writer yet.
-fn pgm(map: &OccupancyGrid) -> Vec<u8> {
-    let mut out = format!("P5\n{} {}\n255\n", map.width(), map.height()).into_bytes();
-    out.extend(
-        map.cells()
-            .iter()
-            .map(|&c| match OccupancyGrid::classify(c) {
-                CellState::Occupied => 0u8,
-                CellState::Free => 254,
-                CellState::Unknown => 205,
-            }),
-    );
-    out
-}
-
-fn yaml(image: &str, map: &OccupancyGrid) -> String {
-    let o = map.origin();
-    format!(
-        "image: {image}\nmode: trinary\nresolution: {}\norigin: [{:?}, {:?}, {:?}]\nnegate: 0\n\
-         occupied_thresh: 0.65\nfree_thresh: 0.196\n",
-        map.resolution(),
-        o.x,
-        o.y,
-        o.yaw
-    )
-}
-
 fn write_case(case: &Case, preset: Preset, dir: &Path) -> Result<()> {
     fs::create_dir_all(dir).with_context(|| format!("{}", dir.display()))?;
     let world_geo = GridGeometry {
@@ -186,12 +176,9 @@ fn write_case(case: &Case, preset: Preset, dir: &Path) -> Result<()> {
     };
     let mut robots = Vec::new();
     for (i, r) in case.robots.iter().enumerate() {
+        // map_saver's trinary PGM (0 occupied, 254 free, 205 unknown) and its YAML.
         let image = format!("robot_{i}.pgm");
-        write_atomic(&dir.join(&image), &pgm(&r.map))?;
-        write_atomic(
-            &dir.join(format!("robot_{i}.yaml")),
-            yaml(&image, &r.map).as_bytes(),
-        )?;
+        grid_core::io::save_map(&r.map, &dir.join(format!("robot_{i}.yaml")))?;
         let pose = r.map_to_world.to_world(&world_geo, &r.map.geometry());
         robots.push(json!({
             "image": image,
@@ -242,12 +229,12 @@ fn write_case(case: &Case, preset: Preset, dir: &Path) -> Result<()> {
     });
     let mut text = serde_json::to_string_pretty(&truth)?;
     text.push('\n');
-    write_atomic(&dir.join("truth.json"), text.as_bytes())?;
+    grid_core::io::write_atomic(&dir.join("truth.json"), text.as_bytes())?;
     let mut png = Vec::new();
     preview(case)
         .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
         .context("encoding preview.png")?;
-    write_atomic(&dir.join("preview.png"), &png)?;
+    grid_core::io::write_atomic(&dir.join("preview.png"), &png)?;
     Ok(())
 }
 

@@ -371,13 +371,48 @@ pub fn generate_case(config: &CaseConfig, seed: u64) -> Result<Case> {
         (-(seg_len * 3 / 10), len as i64)
     };
     let raster = overlap::CoarseRaster::new(&world);
-    let fps: Vec<_> = config
+    // Robots with the same sensor over the same window share one footprint computation (a
+    // reversed robot too when its beams are symmetric under a half turn).
+    let mut computed: Vec<(Key, overlap::Footprints)> = Vec::new();
+    type Key = (std::ops::Range<usize>, RobotConfig, bool);
+    let keys: Vec<Key> = config
         .robots
         .iter()
         .enumerate()
         .map(|(i, r)| {
             let window = overlap::segment(i, n, len, hi);
-            overlap::footprints(&world, &tour, window, r, i % 2 == 1, raster)
+            let reversed = i % 2 == 1 && !overlap::flip_invariant(r);
+            let mut sensor = r.clone();
+            // Noise and dropout do not change the noise-free footprint.
+            sensor.noise_bound = 0.0;
+            sensor.dropout = 0.0;
+            (window, sensor, reversed)
+        })
+        .collect();
+    for key in &keys {
+        if computed.iter().all(|(k, _)| k != key) {
+            let (window, sensor, reversed) = key;
+            let stride = overlap::footprint_stride(sensor, config.pose_step);
+            let fp = overlap::footprints(
+                &world,
+                &tour,
+                window.clone(),
+                sensor,
+                *reversed,
+                raster,
+                stride,
+            );
+            computed.push((key.clone(), fp));
+        }
+    }
+    let fps: Vec<&overlap::Footprints> = keys
+        .iter()
+        .map(|key| {
+            &computed
+                .iter()
+                .find(|(k, _)| k == key)
+                .expect("computed above")
+                .1
         })
         .collect();
     let mut masks = Vec::new();

@@ -8,8 +8,9 @@ use rayon::prelude::*;
 use crate::RobotConfig;
 use crate::planner::PathPose;
 use crate::raycast::traverse;
-use crate::sensor::{beam_dir, failed};
+use crate::sensor::{beam_offsets, failed};
 use crate::world::World;
+use glam::DVec2;
 
 /// Per-pose sets of coarse cells a robot's noise-free sensor observes.
 pub(crate) struct Footprints {
@@ -40,7 +41,21 @@ impl CoarseRaster {
     }
 }
 
-/// Footprints of poses `range` of `tour` (headings already in the robot's direction).
+/// Every `stride`-th pose of a tour is enough to estimate a segment's footprint: consecutive
+/// poses see nearly the same cells, so footprints are computed for poses at most a tenth of
+/// the sensor range apart (and the others count as empty).
+pub(crate) fn footprint_stride(cfg: &RobotConfig, pose_step: f64) -> usize {
+    ((0.1 * cfg.max_range / pose_step).floor() as usize).max(1)
+}
+
+/// Whether a robot driving the tour backwards (heading + pi) sees the same footprint as one
+/// driving it forwards: true when its beams are symmetric under a half turn.
+pub(crate) fn flip_invariant(cfg: &RobotConfig) -> bool {
+    cfg.beams % 2 == 0 && cfg.failed_beams.is_empty()
+}
+
+/// Footprints of poses `range` of `tour` (headings already in the robot's direction); only
+/// poses whose index is a multiple of `stride` are cast, the others are empty.
 pub(crate) fn footprints(
     world: &World,
     tour: &[PathPose],
@@ -48,36 +63,40 @@ pub(crate) fn footprints(
     cfg: &RobotConfig,
     reversed: bool,
     raster: CoarseRaster,
+    stride: usize,
 ) -> Footprints {
-    let n = cfg.beams;
+    let offsets = beam_offsets(cfg.beams);
     let flip = if reversed { std::f64::consts::PI } else { 0.0 };
     let per_pose: Vec<Vec<u32>> = tour[range.clone()]
         .par_iter()
+        .enumerate()
         .map_init(
             || vec![false; raster.w * raster.h],
-            |stamp, p| {
+            |stamp, (k, p)| {
                 let mut cells = Vec::new();
-                for j in (0..n).filter(|&j| !failed(cfg, j)) {
-                    traverse(
-                        p.pos,
-                        beam_dir(p.heading + flip, j, n),
-                        cfg.max_range,
-                        |x, y, _| {
-                            if x < 0 || y < 0 {
-                                return false;
-                            }
-                            let (cx, cy) = (x as usize / raster.f, y as usize / raster.f);
-                            if cx >= raster.w || cy >= raster.h {
-                                return false;
-                            }
-                            let c = cy * raster.w + cx;
-                            if !stamp[c] {
-                                stamp[c] = true;
-                                cells.push(c as u32);
-                            }
-                            !world.is_occupied(x, y)
-                        },
-                    );
+                if (range.start + k) % stride != 0 {
+                    return cells;
+                }
+                let heading = DVec2::from_angle(p.heading + flip);
+                for (j, &o) in offsets.iter().enumerate() {
+                    if failed(cfg, j) {
+                        continue;
+                    }
+                    traverse(p.pos, heading.rotate(o), cfg.max_range, |x, y, _| {
+                        if x < 0 || y < 0 {
+                            return false;
+                        }
+                        let (cx, cy) = (x as usize / raster.f, y as usize / raster.f);
+                        if cx >= raster.w || cy >= raster.h {
+                            return false;
+                        }
+                        let c = cy * raster.w + cx;
+                        if !stamp[c] {
+                            stamp[c] = true;
+                            cells.push(c as u32);
+                        }
+                        !world.is_occupied(x, y)
+                    });
                 }
                 for &c in &cells {
                     stamp[c as usize] = false;
@@ -152,7 +171,7 @@ pub(crate) fn mean_consecutive(m: &[Vec<f64>]) -> f64 {
 
 /// Reference overlap (noise-free, coarse) for extension `delta`.
 pub(crate) fn reference_overlap(
-    fps: &[Footprints],
+    fps: &[&Footprints],
     len: usize,
     delta: i64,
     masks: &mut Vec<u32>,

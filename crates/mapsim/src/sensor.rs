@@ -24,10 +24,12 @@ pub(crate) struct Ray {
     pub hit: bool,
 }
 
-/// Beam direction of beam `j` of `n` at `heading`.
-#[inline]
-pub(crate) fn beam_dir(heading: f64, j: usize, n: usize) -> DVec2 {
-    DVec2::from_angle(heading + TAU * j as f64 / n as f64)
+/// The beams' directions relative to the heading (beam `j` of `n` at `TAU j / n`), computed
+/// once: a beam's world direction is the heading's unit vector rotated by its entry.
+pub(crate) fn beam_offsets(n: usize) -> Vec<DVec2> {
+    (0..n)
+        .map(|j| DVec2::from_angle(TAU * j as f64 / n as f64))
+        .collect()
 }
 
 /// Whether beam `j` is listed as failed.
@@ -45,22 +47,25 @@ pub(crate) fn measure(
     rng: &mut ChaCha8Rng,
 ) -> Vec<Ray> {
     let n = cfg.beams;
+    let offsets = beam_offsets(n);
+    let headings: Vec<DVec2> = poses.iter().map(|p| DVec2::from_angle(p.heading)).collect();
     // Exact distances are the expensive part and need no randomness: do them in parallel.
     let truth: Vec<Option<f64>> = poses
         .par_iter()
-        .flat_map_iter(|p| {
-            (0..n).map(move |j| {
+        .zip(&headings)
+        .flat_map_iter(|(p, &h)| {
+            offsets.iter().enumerate().map(move |(j, &o)| {
                 if failed(cfg, j) {
                     None
                 } else {
-                    cast(world, p.pos, beam_dir(p.heading, j, n), cfg.max_range)
+                    cast(world, p.pos, h.rotate(o), cfg.max_range)
                 }
             })
         })
         .collect();
     let mut rays = Vec::with_capacity(truth.len());
     for (k, t) in truth.iter().enumerate() {
-        let (p, j) = (&poses[k / n], k % n);
+        let (p, h, j) = (&poses[k / n], headings[k / n], k % n);
         if failed(cfg, j) {
             continue;
         }
@@ -83,7 +88,7 @@ pub(crate) fn measure(
         };
         rays.push(Ray {
             origin: p.pos,
-            dir: beam_dir(p.heading, j, n),
+            dir: h.rotate(offsets[j]),
             len,
             hit,
         });

@@ -32,7 +32,7 @@ use std::path::{Path, PathBuf};
 
 use crate::{Error, OccupancyGrid, Pose2, Result};
 
-pub use save::{image_path_for, save_map};
+pub use save::{image_path_for, save_map, write_atomic};
 pub use yaml::{MapMetadata, MapMode};
 
 /// Default for [`LoadOptions::max_cells`]: 100 million cells (10 km x 10 km at 1 m, or

@@ -52,8 +52,9 @@ pub fn save_map(grid: &OccupancyGrid, yaml_path: &Path) -> Result<()> {
 }
 
 /// Write `bytes` to a new temporary file beside `path`, flush it to disk, rename it to `path`.
-/// On failure the temporary file is removed and `path` is untouched.
-fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+/// On failure the temporary file is removed and `path` is untouched: readers never see a
+/// partial file. Used for every output the tools write (maps, JSON, pictures).
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     static COUNTER: AtomicU64 = AtomicU64::new(0);
     let io_err = |source| Error::Io {
         path: path.to_path_buf(),

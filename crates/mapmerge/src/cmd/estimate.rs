@@ -309,27 +309,9 @@ fn write_debug_png(
             }
         }
     }
-    let dir = path
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let tmp = dir.join(format!(
-        ".{}.tmp{}",
-        path.file_name()
-            .and_then(|n| n.to_str())
-            .unwrap_or("debug.png"),
-        std::process::id()
-    ));
-    let result = img
-        .save_with_format(&tmp, image::ImageFormat::Png)
-        .map_err(|e| anyhow::anyhow!("{}: cannot write the debug picture: {e}", path.display()))
-        .and_then(|()| {
-            std::fs::rename(&tmp, path).map_err(|e| {
-                anyhow::anyhow!("{}: cannot write the debug picture: {e}", path.display())
-            })
-        });
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
+    let mut png = Vec::new();
+    img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .map_err(|e| anyhow::anyhow!("{}: cannot encode the debug picture: {e}", path.display()))?;
+    grid_core::io::write_atomic(path, &png)
+        .map_err(|e| anyhow::anyhow!("cannot write the debug picture: {e}"))
 }
