@@ -281,9 +281,18 @@ impl Local<'_> {
     }
 }
 
-/// First pass over one strip with 8-connectivity (Wu's decision tree: the pixel above touches
-/// all other scanned neighbours, so when it is set no union is needed). Returns labels used.
-fn strip_pass8(mask: &[u8], w: usize, labels: &mut [u32], parent: &mut [u32], base: u32) -> u32 {
+/// First pass over one strip: skips empty words, and labels each set pixel with
+/// `decide(tree, west, above, x)` from its west neighbour's label and the row above (`None` on
+/// the strip's first row). Returns labels used.
+#[inline(always)]
+fn strip_pass(
+    mask: &[u8],
+    w: usize,
+    labels: &mut [u32],
+    parent: &mut [u32],
+    base: u32,
+    decide: impl Fn(&mut Local, u32, Option<&[u32]>, usize) -> u32,
+) -> u32 {
     let mut t = Local {
         parent,
         base,
@@ -306,79 +315,53 @@ fn strip_pass8(mask: &[u8], w: usize, labels: &mut [u32], parent: &mut [u32], ba
                 continue;
             }
             let west = if x > 0 { cur[x - 1] } else { 0 };
-            let l = match above {
-                None => {
-                    if west != 0 {
-                        west
-                    } else {
-                        t.new_label()
-                    }
-                }
-                Some(up) => {
-                    let n = up[x];
-                    if n != 0 {
-                        n
-                    } else {
-                        let ne = if x + 1 < w { up[x + 1] } else { 0 };
-                        let nw = if x > 0 { up[x - 1] } else { 0 };
-                        if ne != 0 {
-                            if west != 0 {
-                                t.union(ne, west)
-                            } else if nw != 0 {
-                                t.union(ne, nw)
-                            } else {
-                                ne
-                            }
-                        } else if west != 0 {
-                            west
-                        } else if nw != 0 {
-                            nw
-                        } else {
-                            t.new_label()
-                        }
-                    }
-                }
-            };
-            cur[x] = l;
+            cur[x] = decide(&mut t, west, above, x);
             x += 1;
         }
     }
     t.next
 }
 
-/// First pass over one strip with 4-connectivity. Returns labels used.
-fn strip_pass4(mask: &[u8], w: usize, labels: &mut [u32], parent: &mut [u32], base: u32) -> u32 {
-    let mut t = Local {
-        parent,
-        base,
-        next: 0,
-    };
-    for (y, row) in mask.chunks_exact(w).enumerate() {
-        let (done, rest) = labels.split_at_mut(y * w);
-        let cur = &mut rest[..w];
-        let above: Option<&[u32]> = (y > 0).then(|| &done[(y - 1) * w..]);
-        let mut x = 0;
-        while x < w {
-            if x + WORD <= w && is_zero_word(&row[x..x + WORD]) {
-                cur[x..x + WORD].fill(0);
-                x += WORD;
-                continue;
-            }
-            if row[x] == 0 {
-                cur[x] = 0;
-                x += 1;
-                continue;
-            }
-            let west = if x > 0 { cur[x - 1] } else { 0 };
-            let north = above.map_or(0, |up| up[x]);
-            cur[x] = match (west != 0, north != 0) {
-                (true, true) => t.union(west, north),
-                (true, false) => west,
-                (false, true) => north,
-                (false, false) => t.new_label(),
-            };
-            x += 1;
+/// First pass with 8-connectivity (Wu's decision tree: the pixel above touches all other
+/// scanned neighbours, so when it is set no union is needed).
+fn strip_pass8(mask: &[u8], w: usize, labels: &mut [u32], parent: &mut [u32], base: u32) -> u32 {
+    strip_pass(mask, w, labels, parent, base, |t, west, above, x| {
+        let Some(up) = above else {
+            return if west != 0 { west } else { t.new_label() };
+        };
+        let n = up[x];
+        if n != 0 {
+            return n;
         }
-    }
-    t.next
+        let ne = if x + 1 < w { up[x + 1] } else { 0 };
+        let nw = if x > 0 { up[x - 1] } else { 0 };
+        if ne != 0 {
+            if west != 0 {
+                t.union(ne, west)
+            } else if nw != 0 {
+                t.union(ne, nw)
+            } else {
+                ne
+            }
+        } else if west != 0 {
+            west
+        } else if nw != 0 {
+            nw
+        } else {
+            t.new_label()
+        }
+    })
+}
+
+/// First pass with 4-connectivity.
+fn strip_pass4(mask: &[u8], w: usize, labels: &mut [u32], parent: &mut [u32], base: u32) -> u32 {
+    strip_pass(mask, w, labels, parent, base, |t, west, above, x| {
+        let north = above.map_or(0, |up| up[x]);
+        match (west != 0, north != 0) {
+            (true, true) => t.union(west, north),
+            (true, false) => west,
+            (false, true) => north,
+            (false, false) => t.new_label(),
+        }
+    })
 }
