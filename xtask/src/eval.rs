@@ -41,6 +41,13 @@ pub struct EvalArgs {
     /// World size in cells for the simulated suites.
     #[arg(long, default_value_t = 400)]
     size: usize,
+    /// Skip the correlative local search before ICP (to measure what it adds).
+    #[arg(long)]
+    no_search: bool,
+    /// Override the verification's wall tolerance in pixels (default: the library's), for
+    /// calibration experiments.
+    #[arg(long)]
+    wall_tolerance: Option<f32>,
 }
 
 /// One row of a suite: a configuration and whether success means declining.
@@ -195,6 +202,10 @@ struct Outcome {
     error: Option<String>,
     /// Scores of the best candidate (accepted or not), for calibrating the verification.
     best: Option<mapmerge::Candidate>,
+    /// Displacement error of the best candidate, accepted or not (px).
+    best_displacement_error_px: Option<f64>,
+    /// Every candidate's scores and displacement error (px), for calibrating acceptance.
+    candidates: Vec<(mapmerge::verify::Verification, Option<f64>)>,
     timings: Option<mapmerge::Timings>,
     correspondences: Option<mapmerge::KindTotals>,
     /// Scores of the true transform, and how far refinement started at the truth drifts
@@ -204,7 +215,7 @@ struct Outcome {
 }
 
 /// Generate case `seed` of `row` once and register it with every method.
-fn run_case(row: &Row, methods: &[Method], seed: u64) -> Vec<Outcome> {
+fn run_case(row: &Row, methods: &[Method], seed: u64, args: &EvalArgs) -> Vec<Outcome> {
     let blank = |method: Method| Outcome {
         suite: row.suite,
         row: row.label.clone(),
@@ -218,6 +229,8 @@ fn run_case(row: &Row, methods: &[Method], seed: u64) -> Vec<Outcome> {
         millis: 0.0,
         error: None,
         best: None,
+        best_displacement_error_px: None,
+        candidates: Vec::new(),
         timings: None,
         correspondences: None,
         truth_verification: None,
@@ -239,7 +252,13 @@ fn run_case(row: &Row, methods: &[Method], seed: u64) -> Vec<Outcome> {
     let truth = case.truth(0, 1);
     // What the verification and the refinement reach at best, started at the truth; the
     // same for every method.
-    let defaults = RegisterConfig::default();
+    let mut defaults = RegisterConfig::default();
+    if let Some(t) = args.wall_tolerance {
+        defaults.pair.verify.wall_tolerance_px = t;
+    }
+    if args.no_search {
+        defaults.pair.search = None;
+    }
     let (truth_verification, truth_refined_drift_px) = if row.expect_decline {
         (None, None)
     } else {
@@ -260,7 +279,7 @@ fn run_case(row: &Row, methods: &[Method], seed: u64) -> Vec<Outcome> {
             out.truth_refined_drift_px = truth_refined_drift_px;
             let config = RegisterConfig {
                 method,
-                ..RegisterConfig::default()
+                ..defaults.clone()
             };
             let t0 = Instant::now();
             let result = match register(a, b, &config) {
@@ -272,6 +291,15 @@ fn run_case(row: &Row, methods: &[Method], seed: u64) -> Vec<Outcome> {
             };
             out.millis = t0.elapsed().as_secs_f64() * 1e3;
             out.best = result.candidates.first().cloned();
+            out.candidates = result
+                .candidates
+                .iter()
+                .map(|c| (c.verification, displacement_error(b, &c.transform, &truth)))
+                .collect();
+            out.best_displacement_error_px = out
+                .best
+                .as_ref()
+                .and_then(|c| displacement_error(b, &c.transform, &truth));
             out.timings = Some(result.timings);
             out.correspondences = Some(result.correspondences);
             if let Some(c) = &result.accepted {
@@ -320,7 +348,7 @@ pub fn run(args: EvalArgs) -> Result<()> {
     let outcomes: Vec<Outcome> = jobs
         .par_iter()
         .flat_map_iter(|&(r, seed)| {
-            let o = run_case(&rows[r], &args.methods, seed);
+            let o = run_case(&rows[r], &args.methods, seed, &args);
             bar.inc(1);
             o
         })
@@ -337,7 +365,7 @@ pub fn run(args: EvalArgs) -> Result<()> {
         for &m in &args.methods {
             let os: Vec<&Outcome> = outcomes
                 .iter()
-                .filter(|o| o.row == row.label && o.method == m.to_string())
+                .filter(|o| o.suite == row.suite && o.row == row.label && o.method == m.to_string())
                 .collect();
             let n = os.len().max(1) as f64;
             let pct = |k: usize| format!("{:.0}%", 100.0 * k as f64 / n);

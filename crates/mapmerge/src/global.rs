@@ -14,7 +14,7 @@ use grid_core::{CellState, DVec2, Rigid2};
 use rustfft::FftPlanner;
 use rustfft::num_complex::Complex32;
 
-use crate::verify::PreparedMap;
+use crate::verify::{PreparedMap, strided};
 
 /// Parameters of the global search, with documented defaults.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -42,16 +42,6 @@ impl Default for GlobalConfig {
             translation_peaks: 2,
         }
     }
-}
-
-fn subsample(points: &[DVec2], max: usize) -> Vec<DVec2> {
-    if points.len() <= max {
-        return points.to_vec();
-    }
-    let step = points.len() as f64 / max as f64;
-    (0..max)
-        .map(|i| points[(i as f64 * step) as usize])
-        .collect()
 }
 
 /// Hough spectrum of a point set: for each line-normal angle, the sum of squared accumulator
@@ -184,8 +174,8 @@ pub fn global_hypotheses(
     config: &GlobalConfig,
     out: &mut Vec<Rigid2>,
 ) {
-    let pa = subsample(&a.wall_samples, config.max_points);
-    let pb = subsample(&b.wall_samples, config.max_points);
+    let pa = strided(&a.wall_samples, config.max_points);
+    let pb = strided(&b.wall_samples, config.max_points);
     if pa.len() < 10 || pb.len() < 10 {
         return;
     }

@@ -9,6 +9,7 @@ pub mod distance;
 pub mod global;
 pub mod refine;
 mod register;
+pub mod search;
 pub mod verify;
 
 pub use register::{

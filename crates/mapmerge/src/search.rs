@@ -1,0 +1,253 @@
+//! Correlative local search: move a hypothesis to the best-scoring translation within a few
+//! pixels before ICP polishes it.
+//!
+//! A hypothesis is fixed by a handful of keypoints located to a few pixels on a noisy map (or,
+//! from the global search, by a coarse grid); ICP with a small robust scale (see
+//! [`crate::refine`]) keeps a good pose exactly but cannot pull a pose that starts 4-6 px off,
+//! because near such a pose no wall pairs agree well enough to carry weight. The search scores
+//! every pose of a coarse-to-fine grid around the hypothesis on both maps' walls, as
+//! correlative scan matching does (Olson 2009): each wall cell of one map adds
+//! `exp(-d^2 / 2 sigma^2)` for the distance `d` to the nearest wall of the other map (nothing
+//! where that map is unknown), in both directions. The pose with the highest score wins; ties
+//! keep the hypothesis. The window is small, so the search improves a hypothesis; it cannot
+//! make a wrong one right.
+//!
+//! By default only the translation is searched. Measured with `cargo xtask eval --suites
+//! overlap,mismatch --cases 20` (hybrid): without the search 78 % of the disaster pairs at 50 %
+//! overlap and 35 % of the 10 %/15 % noise pairs succeeded; with the translation search 90 %
+//! and 65 %. Searching +-2 degrees as well did worse at 30 % overlap (15 % instead of 30 %, the
+//! median rotation error doubled to 0.77 degrees) and cost 5 times as much: the walls of a
+//! noisy range sensor are pushed away from the robot by about the noise bound times the range,
+//! differently in each map, and a slightly rotated pose can fit those biased walls better than
+//! the true one. Rotation is left to ICP.
+
+use grid_core::{CellState, DVec2, Rigid2};
+
+use crate::verify::{PreparedMap, strided};
+
+/// The search window and grid, with documented defaults.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SearchConfig {
+    /// Largest translation tried, in pixels, along each axis. Default 8.
+    pub radius_px: f64,
+    /// Translation step of the coarse grid, in pixels; each finer level halves it. Default 2.
+    pub step_px: f64,
+    /// Largest rotation tried, in degrees. Default 0: translation only (see the module docs).
+    pub max_angle_deg: f64,
+    /// Rotation step of the coarse grid, in degrees; each finer level halves it. Default 1.
+    pub angle_step_deg: f64,
+    /// Finer levels after the coarse grid, each a 3 x 3 x 3 grid at half the previous steps
+    /// around the best pose so far. Default 3 (final steps 0.25 px and 0.125 degrees).
+    pub levels: usize,
+    /// Width of the score kernel, in pixels. Default 1.5: about the spread of a wall's cells
+    /// under 10 % range noise at the simulator's ranges.
+    pub sigma_px: f64,
+    /// Wall cells used per map on the finer levels (strided sample). Default 2000.
+    pub max_points: usize,
+    /// Wall cells used per map on the coarse grid, the bulk of the poses. Default 500.
+    pub coarse_points: usize,
+}
+
+impl Default for SearchConfig {
+    fn default() -> Self {
+        Self {
+            radius_px: 8.0,
+            step_px: 2.0,
+            max_angle_deg: 0.0,
+            angle_step_deg: 1.0,
+            levels: 3,
+            sigma_px: 1.5,
+            max_points: 2000,
+            coarse_points: 500,
+        }
+    }
+}
+
+/// Kernel values by distance in quarter pixels, zero beyond 4 sigma.
+struct Kernel {
+    table: Vec<f32>,
+}
+
+impl Kernel {
+    fn new(sigma: f64) -> Self {
+        let n = (16.0 * sigma).ceil() as usize + 1;
+        let table = (0..n)
+            .map(|i| {
+                let d = i as f64 / 4.0;
+                (-d * d / (2.0 * sigma * sigma)).exp() as f32
+            })
+            .collect();
+        Self { table }
+    }
+
+    #[inline]
+    fn at(&self, d: f32) -> f32 {
+        let i = (d * 4.0) as usize;
+        self.table.get(i).copied().unwrap_or(0.0)
+    }
+}
+
+/// Sum of kernel values of `points` mapped by `t` onto `onto`'s walls.
+fn half_score(points: &[DVec2], onto: &PreparedMap, t: &Rigid2, k: &Kernel) -> f32 {
+    let (w, h) = (onto.grid.width() as f64, onto.grid.height() as f64);
+    let rot = DVec2::from_angle(t.theta);
+    let shift = t.translation();
+    let mut s = 0.0;
+    for &p in points {
+        let q = rot.rotate(p) + shift;
+        let (x, y) = (q.x.round(), q.y.round());
+        if x < 0.0 || y < 0.0 || x >= w || y >= h {
+            continue;
+        }
+        let (x, y) = (x as usize, y as usize);
+        if onto.grid.state(x, y) == CellState::Unknown {
+            continue;
+        }
+        s += k.at(onto.walls.distance(x, y));
+    }
+    s
+}
+
+/// The best pose near `b_to_a` (maps pixels of `b` onto `a`) by the correlative score.
+pub fn local_search(
+    a: &PreparedMap,
+    b: &PreparedMap,
+    b_to_a: &Rigid2,
+    config: &SearchConfig,
+) -> Rigid2 {
+    let pa = strided(&a.wall_samples, config.max_points);
+    let pb = strided(&b.wall_samples, config.max_points);
+    if pa.is_empty() || pb.is_empty() {
+        return *b_to_a;
+    }
+    let (ca, cb) = (
+        strided(&pa, config.coarse_points),
+        strided(&pb, config.coarse_points),
+    );
+    let kernel = Kernel::new(config.sigma_px);
+    // Rotate about B's wall centroid as placed by the hypothesis, so a rotation step does not
+    // also swing the translation.
+    let centre = b_to_a.apply(pb.iter().copied().sum::<DVec2>() / pb.len() as f64);
+    let pose = |dtheta: f64, d: DVec2| {
+        let about = Rigid2::new(0.0, centre.x, centre.y)
+            .compose(&Rigid2::new(dtheta, 0.0, 0.0))
+            .compose(&Rigid2::new(0.0, -centre.x, -centre.y));
+        Rigid2::new(0.0, d.x, d.y).compose(&about).compose(b_to_a)
+    };
+    let score = |t: &Rigid2, coarse: bool| {
+        let (pa, pb) = if coarse { (&ca, &cb) } else { (&pa, &pb) };
+        half_score(pb, a, t, &kernel) + half_score(pa, b, &t.inverse(), &kernel)
+    };
+    let mut best = (0.0, DVec2::ZERO);
+    let mut best_score = score(b_to_a, true);
+    let mut step = config.step_px;
+    let mut astep = config.angle_step_deg.to_radians();
+    let (mut n_t, mut n_a) = (
+        (config.radius_px / config.step_px).round() as i64,
+        if config.max_angle_deg > 0.0 {
+            (config.max_angle_deg / config.angle_step_deg).round() as i64
+        } else {
+            0
+        },
+    );
+    for level in 0..=config.levels {
+        if level == 1 {
+            // The finer levels compare on more points: rescore the winner on them.
+            best_score = score(&pose(best.0, best.1), false);
+        }
+        let coarse = level == 0;
+        let (theta0, d0) = best;
+        for ia in -n_a..=n_a {
+            let dtheta = theta0 + ia as f64 * astep;
+            for iy in -n_t..=n_t {
+                for ix in -n_t..=n_t {
+                    let d = d0 + DVec2::new(ix as f64, iy as f64) * step;
+                    let s = score(&pose(dtheta, d), coarse);
+                    // Strictly better only: on a plateau the hypothesis (or the earlier pose)
+                    // stays, which keeps the result independent of the grid's visiting order.
+                    if s > best_score {
+                        best_score = s;
+                        best = (dtheta, d);
+                    }
+                }
+            }
+        }
+        if level < config.levels {
+            step /= 2.0;
+            astep /= 2.0;
+            // Half steps, one each way: covers the half-cell the coarser level could not split.
+            n_t = 1;
+            n_a = n_a.min(1);
+        }
+    }
+    if best == (0.0, DVec2::ZERO) {
+        *b_to_a
+    } else {
+        pose(best.0, best.1)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::verify::VerifyConfig;
+    use grid_core::{OccupancyGrid, Pose2, UNKNOWN};
+
+    /// An L-shaped room with a pillar: walls in both directions pin the pose.
+    fn room() -> OccupancyGrid {
+        let (w, h) = (120, 100);
+        let mut cells = vec![UNKNOWN; w * h];
+        for y in 10..90 {
+            for x in 10..110 {
+                let wall = x == 10 || x == 109 || y == 10 || y == 89 || (x >= 60 && y == 50);
+                let pillar = (30..36).contains(&x) && (30..34).contains(&y);
+                cells[y * w + x] = if wall || pillar { 100 } else { 0 };
+            }
+        }
+        OccupancyGrid::from_cells(w, h, 0.05, Pose2::default(), cells).unwrap()
+    }
+
+    #[test]
+    fn a_hypothesis_a_few_pixels_off_moves_to_the_truth() {
+        let a = room();
+        let truth = Rigid2::new(0.0, 0.0, 0.0);
+        let vc = VerifyConfig::default();
+        let (pa, pb) = (PreparedMap::new(&a, &vc), PreparedMap::new(&a, &vc));
+        let with_rotation = SearchConfig {
+            max_angle_deg: 2.0,
+            ..SearchConfig::default()
+        };
+        for (start, config) in [
+            (Rigid2::new(0.0, 5.0, -4.0), SearchConfig::default()),
+            (Rigid2::new(0.0, -6.0, 3.0), SearchConfig::default()),
+            (Rigid2::new(0.0, 7.0, 7.0), SearchConfig::default()),
+            (Rigid2::new(1.5f64.to_radians(), 5.0, -4.0), with_rotation),
+            (Rigid2::new(-1.0f64.to_radians(), -6.0, 3.0), with_rotation),
+        ] {
+            let found = local_search(&pa, &pb, &start, &config);
+            let err = grid_core::metrics::displacement_error(&a, &found, &truth).unwrap();
+            // Scores are read at the nearest cell, so poses within half a cell tie: the
+            // search lands within a pixel and ICP does the sub-pixel part.
+            assert!(err < 1.0, "from {start:?}: {found:?} is {err} px off");
+            if config.max_angle_deg > 0.0 {
+                // Nearest-cell scores make plateaus in angle too: within half a coarse step.
+                let rot = grid_core::metrics::rotation_error_deg(&found, &truth);
+                assert!(
+                    rot <= 0.5 * config.angle_step_deg + 1e-9,
+                    "from {start:?}: rotation {rot} degrees off"
+                );
+            } else {
+                assert_eq!(found.theta, start.theta, "translation-only search turned");
+            }
+        }
+    }
+
+    #[test]
+    fn the_truth_stays_put() {
+        let a = room();
+        let vc = VerifyConfig::default();
+        let (pa, pb) = (PreparedMap::new(&a, &vc), PreparedMap::new(&a, &vc));
+        let found = local_search(&pa, &pb, &Rigid2::default(), &SearchConfig::default());
+        assert_eq!(found, Rigid2::default());
+    }
+}
