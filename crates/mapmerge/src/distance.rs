@@ -9,10 +9,19 @@ use grid_core::{CellState, OccupancyGrid};
 const NONE: u32 = u32::MAX;
 
 /// For each cell of a grid, the nearest occupied cell and the distance to it.
+///
+/// Only the bounding box of the grid's known cells is computed: every occupied cell lies in
+/// it, and the box is convex, so distances inside it are what the whole grid would give.
+/// Outside it every cell is unknown, and queries there report no wall (a big canvas of
+/// unknown around a map costs nothing).
 #[derive(Debug, Clone)]
 pub struct NearestOccupied {
+    /// The computed window: first column and row, width and height.
+    x0: usize,
+    y0: usize,
     width: usize,
     height: usize,
+    /// Nearest site per window cell, as a window index.
     nearest: Vec<u32>,
     distance: Vec<f32>,
 }
@@ -20,16 +29,23 @@ pub struct NearestOccupied {
 impl NearestOccupied {
     /// Build the transform of `grid`'s occupied cells.
     pub fn new(grid: &OccupancyGrid) -> Self {
-        let (w, h) = (grid.width(), grid.height());
+        let (x0, y0, w, h) = known_window(grid);
         let mut nearest = vec![NONE; w * h];
         let mut distance = vec![f32::INFINITY; w * h];
-        for (i, &c) in grid.cells().iter().enumerate() {
-            if OccupancyGrid::classify(c) == CellState::Occupied {
-                nearest[i] = i as u32;
-                distance[i] = 0.0;
+        let gw = grid.width();
+        for y in 0..h {
+            let row = &grid.cells()[(y0 + y) * gw + x0..][..w];
+            for (x, &c) in row.iter().enumerate() {
+                if OccupancyGrid::classify(c) == CellState::Occupied {
+                    let i = y * w + x;
+                    nearest[i] = i as u32;
+                    distance[i] = 0.0;
+                }
             }
         }
         let mut out = Self {
+            x0,
+            y0,
             width: w,
             height: h,
             nearest,
@@ -56,6 +72,11 @@ impl NearestOccupied {
         out
     }
 
+    /// The computed window `(x0, y0, width, height)`: the bounding box of the known cells.
+    pub fn window(&self) -> (usize, usize, usize, usize) {
+        (self.x0, self.y0, self.width, self.height)
+    }
+
     #[inline]
     fn relax(&mut self, x: usize, y: usize, nx: isize, ny: isize, step: f32) {
         if nx < 0 || ny < 0 || nx as usize >= self.width || ny as usize >= self.height {
@@ -71,32 +92,64 @@ impl NearestOccupied {
         }
     }
 
-    /// Nearest occupied cell `(x, y)` to cell `(x, y)` and its distance; `None` outside the grid
-    /// or when the grid has no occupied cell.
+    /// Window index of grid cell `(x, y)`, if it lies in the window.
+    #[inline]
+    fn index(&self, x: usize, y: usize) -> Option<usize> {
+        let (x, y) = (x.wrapping_sub(self.x0), y.wrapping_sub(self.y0));
+        (x < self.width && y < self.height).then(|| y * self.width + x)
+    }
+
+    /// Nearest occupied cell `(x, y)` to cell `(x, y)` and its distance; `None` outside the
+    /// known window or when the grid has no occupied cell.
     #[inline]
     pub fn nearest(&self, x: usize, y: usize) -> Option<((usize, usize), f32)> {
-        if x >= self.width || y >= self.height {
-            return None;
-        }
-        let i = y * self.width + x;
+        let i = self.index(x, y)?;
         let site = self.nearest[i];
         (site != NONE).then(|| {
             (
-                (site as usize % self.width, site as usize / self.width),
+                (
+                    self.x0 + site as usize % self.width,
+                    self.y0 + site as usize / self.width,
+                ),
                 self.distance[i],
             )
         })
     }
 
-    /// Distance from cell `(x, y)` to the nearest occupied cell (infinite when none).
+    /// Distance from cell `(x, y)` to the nearest occupied cell (infinite when none, and
+    /// outside the known window).
     #[inline]
     pub fn distance(&self, x: usize, y: usize) -> f32 {
-        if x >= self.width || y >= self.height {
-            f32::INFINITY
-        } else {
-            self.distance[y * self.width + x]
-        }
+        self.index(x, y).map_or(f32::INFINITY, |i| self.distance[i])
     }
+}
+
+/// Bounding box `(x0, y0, width, height)` of the known cells of `grid` (the whole grid when
+/// none is known, which the loaders refuse anyway).
+pub fn known_window(grid: &OccupancyGrid) -> (usize, usize, usize, usize) {
+    let (w, h) = (grid.width(), grid.height());
+    let (mut x0, mut y0, mut x1, mut y1) = (usize::MAX, usize::MAX, 0, 0);
+    for (y, row) in grid.cells().chunks_exact(w).enumerate() {
+        let mut known = row.iter().map(|&c| c != grid_core::UNKNOWN);
+        let Some(first) = known.position(|k| k) else {
+            continue;
+        };
+        let last = w
+            - 1
+            - row
+                .iter()
+                .rev()
+                .position(|&c| c != grid_core::UNKNOWN)
+                .unwrap_or(0);
+        x0 = x0.min(first);
+        x1 = x1.max(last);
+        y0 = y0.min(y);
+        y1 = y1.max(y);
+    }
+    if x0 == usize::MAX {
+        return (0, 0, w, h);
+    }
+    (x0, y0, x1 - x0 + 1, y1 - y0 + 1)
 }
 
 #[cfg(test)]
@@ -147,5 +200,38 @@ mod tests {
         let t = NearestOccupied::new(&g);
         assert!(t.nearest(1, 1).is_none());
         assert_eq!(t.distance(1, 1), f32::INFINITY);
+    }
+
+    #[test]
+    fn only_the_known_window_is_computed_and_it_is_exact() {
+        // A 12 x 8 known patch with two walls on a 60 x 50 canvas of unknown.
+        let (w, h) = (60, 50);
+        let mut cells = vec![UNKNOWN; w * h];
+        for y in 20..28 {
+            for x in 30..42 {
+                cells[y * w + x] = if (x == 30 && y < 25) || (y == 27 && x > 35) { 100 } else { 0 };
+            }
+        }
+        let g = OccupancyGrid::from_cells(w, h, 0.05, Pose2::default(), cells.clone()).unwrap();
+        let t = NearestOccupied::new(&g);
+        assert_eq!(t.window(), (30, 20, 12, 8));
+        for y in 20..28 {
+            for x in 30..42 {
+                let exact = (0..w * h)
+                    .filter(|&i| cells[i] == 100)
+                    .map(|i| {
+                        let (sx, sy) = ((i % w) as f32, (i / w) as f32);
+                        ((sx - x as f32).powi(2) + (sy - y as f32).powi(2)).sqrt()
+                    })
+                    .fold(f32::INFINITY, f32::min);
+                let ((nx, ny), d) = t.nearest(x, y).unwrap();
+                assert!((d - exact).abs() < 0.1, "({x}, {y}): {d} vs {exact}");
+                assert_eq!(cells[ny * w + nx], 100, "the nearest site is a wall");
+            }
+        }
+        // Outside the window: unknown, no wall reported.
+        assert!(t.nearest(5, 5).is_none());
+        assert_eq!(t.distance(29, 20), f32::INFINITY);
+        assert_eq!(t.distance(42, 27), f32::INFINITY);
     }
 }

@@ -2,6 +2,8 @@
 
 use std::time::Instant;
 
+use rayon::prelude::*;
+
 use blob_features::{BlobConfig, BlobCorrespondences, Blobs};
 use grid_core::{Correspondence, CorrespondenceSource, EvidenceKind, OccupancyGrid, Rigid2};
 use ransac_rigid::{RansacConfig, estimate_rigid};
@@ -70,11 +72,11 @@ pub struct Candidate {
 /// Wall-clock time of each stage, in milliseconds.
 #[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
 pub struct Timings {
-    /// Feature extraction and matching.
+    /// Feature extraction and matching (runs beside `prepare_ms`: the two overlap).
     pub correspondences_ms: f64,
     /// RANSAC.
     pub ransac_ms: f64,
-    /// Precomputation of both maps for verification.
+    /// Precomputation of both maps for verification (runs beside `correspondences_ms`).
     pub prepare_ms: f64,
     /// Refinement and verification of all candidates.
     pub verify_ms: f64,
@@ -135,16 +137,36 @@ fn ms(t: Instant) -> f64 {
 pub fn register_with(
     a: &OccupancyGrid,
     b: &OccupancyGrid,
-    sources: &[&dyn CorrespondenceSource],
+    sources: &[&(dyn CorrespondenceSource + Sync)],
     config: &PairConfig,
 ) -> Registration {
     let mut timings = Timings::default();
-    let t0 = Instant::now();
-    let mut corrs = Vec::new();
-    for s in sources {
-        s.correspondences(a, b, &mut corrs);
-    }
-    timings.correspondences_ms = ms(t0);
+    // The sources, and the maps' preparation for verification, are independent: run them
+    // side by side (their times overlap). Sources are concatenated in the given order.
+    let ((corrs, correspondences_ms), ((pa, pb), prepare_ms)) = rayon::join(
+        || {
+            let t0 = Instant::now();
+            let parts: Vec<Vec<Correspondence>> = sources
+                .par_iter()
+                .map(|s| {
+                    let mut out = Vec::new();
+                    s.correspondences(a, b, &mut out);
+                    out
+                })
+                .collect();
+            (parts.concat(), ms(t0))
+        },
+        || {
+            let t0 = Instant::now();
+            let maps = rayon::join(
+                || PreparedMap::new(a, &config.verify),
+                || PreparedMap::new(b, &config.verify),
+            );
+            (maps, ms(t0))
+        },
+    );
+    timings.correspondences_ms = correspondences_ms;
+    timings.prepare_ms = prepare_ms;
     let correspondences = KindTotals::of(&corrs, 0..corrs.len());
     let declined = |reason: String, timings, candidates| Registration {
         accepted: None,
@@ -163,13 +185,6 @@ pub fn register_with(
         .as_ref()
         .map(|r| r.hypotheses.as_slice())
         .unwrap_or_default();
-
-    let t0 = Instant::now();
-    let (pa, pb) = rayon::join(
-        || PreparedMap::new(a, &config.verify),
-        || PreparedMap::new(b, &config.verify),
-    );
-    timings.prepare_ms = ms(t0);
 
     let t0 = Instant::now();
     // Each hypothesis is polished by ICP, and feature hypotheses also from the best pose of the
@@ -356,7 +371,7 @@ pub fn register(
         blobs: Blobs::new(config.blobs),
         matching: config.blob_matching,
     };
-    let sources: Vec<&dyn CorrespondenceSource> = match config.method {
+    let sources: Vec<&(dyn CorrespondenceSource + Sync)> = match config.method {
         Method::Sift => vec![&sift],
         Method::Blobs => vec![&blobs],
         Method::Hybrid => vec![&sift, &blobs],

@@ -88,8 +88,9 @@ pub struct PreparedMap<'a> {
     pub wall_base_rate: f64,
     /// The same share for the wide tolerance.
     pub wide_base_rate: f64,
-    /// Per cell, the angle (radians, `[0, pi)`) of the wall normal at an occupied cell, NaN
-    /// where the cell is not occupied or the local wall has no clear direction.
+    /// Per cell of the known window (see [`NearestOccupied::window`]), the angle (radians,
+    /// `[0, pi)`) of the wall normal at an occupied cell, NaN where the cell is not occupied or
+    /// the local wall has no clear direction.
     pub normals: Vec<f32>,
 }
 
@@ -108,10 +109,12 @@ impl<'a> PreparedMap<'a> {
     /// Precompute the nearest-wall transform and the samples of `grid`.
     pub fn new(grid: &'a OccupancyGrid, config: &VerifyConfig) -> Self {
         let walls = NearestOccupied::new(grid);
+        // Everything outside the known window is unknown.
+        let (x0, y0, ww, wh) = walls.window();
         let (mut occ, mut known) = (Vec::new(), Vec::new());
         let (mut near, mut near_wide) = (0usize, 0usize);
-        for y in 0..grid.height() {
-            for x in 0..grid.width() {
+        for y in y0..y0 + wh {
+            for x in x0..x0 + ww {
                 let s = grid.state(x, y);
                 if s == CellState::Unknown {
                     continue;
@@ -131,7 +134,7 @@ impl<'a> PreparedMap<'a> {
             }
         }
         let known_cells = known.len();
-        let normals = wall_normals(grid);
+        let normals = wall_normals(grid, (x0, y0, ww, wh));
         let rate = |n: usize| {
             if known_cells == 0 {
                 0.0
@@ -155,19 +158,25 @@ impl<'a> PreparedMap<'a> {
     /// Unit normal of the wall at occupied cell `(x, y)`, if it has a clear direction.
     #[inline]
     pub fn normal(&self, x: usize, y: usize) -> Option<DVec2> {
-        let a = *self.normals.get(y * self.grid.width() + x)?;
+        let (x0, y0, ww, wh) = self.walls.window();
+        let (x, y) = (x.wrapping_sub(x0), y.wrapping_sub(y0));
+        if x >= ww || y >= wh {
+            return None;
+        }
+        let a = self.normals[y * ww + x];
         (!a.is_nan()).then(|| DVec2::from_angle(a as f64))
     }
 }
 
 /// Wall normals from the second moments of the occupied cells in a 5 x 5 window: the wall runs
 /// along the principal axis, the normal across it. Blobs without a dominant axis get NaN.
-fn wall_normals(grid: &OccupancyGrid) -> Vec<f32> {
+fn wall_normals(grid: &OccupancyGrid, window: (usize, usize, usize, usize)) -> Vec<f32> {
     const R: isize = 2;
     let (w, h) = (grid.width() as isize, grid.height() as isize);
-    let mut out = vec![f32::NAN; grid.cells().len()];
-    for y in 0..h {
-        for x in 0..w {
+    let (x0, y0, ww, wh) = window;
+    let mut out = vec![f32::NAN; ww * wh];
+    for y in y0 as isize..(y0 + wh) as isize {
+        for x in x0 as isize..(x0 + ww) as isize {
             if grid.state(x as usize, y as usize) != CellState::Occupied {
                 continue;
             }
@@ -202,7 +211,7 @@ fn wall_normals(grid: &OccupancyGrid) -> Vec<f32> {
             }
             // Principal axis angle; the normal is a quarter turn from it.
             let axis = 0.5 * (2.0 * cxy).atan2(cxx - cyy);
-            out[(y * w + x) as usize] =
+            out[(y as usize - y0) * ww + (x as usize - x0)] =
                 (axis + std::f64::consts::FRAC_PI_2).rem_euclid(std::f64::consts::PI) as f32;
         }
     }

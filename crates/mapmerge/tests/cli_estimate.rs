@@ -227,7 +227,7 @@ fn registers_from_area_evidence_alone() {
         blobs: blob_features::Blobs::new(blob_features::BlobConfig::default()),
         matching: blob_features::MatchConfig::default(),
     };
-    let sources: [&dyn CorrespondenceSource; 1] = [&blobs];
+    let sources: [&(dyn CorrespondenceSource + Sync); 1] = [&blobs];
     let config = PairConfig {
         global: None,
         ..PairConfig::default()
