@@ -420,26 +420,32 @@ pub fn generate_case(config: &CaseConfig, seed: u64) -> Result<Case> {
     let safety = (0.25 * min_range / config.pose_step).ceil() as i64;
     let delta = overlap::choose_delta(&mut eval, config.overlap, lo, hi, safety);
 
-    let mut robots = Vec::with_capacity(n);
-    for (i, rc) in config.robots.iter().enumerate() {
-        let mut poses: Vec<_> = tour[overlap::segment(i, n, len, delta)].to_vec();
-        if i % 2 == 1 {
-            // Odd robots drive the tour backwards, so neighbours start far apart.
-            poses.reverse();
-            for p in &mut poses {
-                p.heading += PI;
+    // Robots are independent (each draws from its own random stream), so they are simulated
+    // side by side; mapping one robot's rays is sequential (clamped log-odds depend on order).
+    let robots = config
+        .robots
+        .par_iter()
+        .enumerate()
+        .map(|(i, rc)| {
+            let mut poses: Vec<_> = tour[overlap::segment(i, n, len, delta)].to_vec();
+            if i % 2 == 1 {
+                // Odd robots drive the tour backwards, so neighbours start far apart.
+                poses.reverse();
+                for p in &mut poses {
+                    p.heading += PI;
+                }
             }
-        }
-        let mut r = rng(seed, STREAM_ROBOT + i as u64);
-        let rays = sensor::measure(&world, &poses, rc, &mut r);
-        let (map, map_to_world) =
-            sensor::build_map(&rays, &poses, config, world.resolution(), &mut r)?;
-        robots.push(RobotMap {
-            map,
-            map_to_world,
-            path: poses.iter().map(|p| p.pos).collect(),
-        });
-    }
+            let mut r = rng(seed, STREAM_ROBOT + i as u64);
+            let rays = sensor::measure(&world, &poses, rc, &mut r);
+            let (map, map_to_world) =
+                sensor::build_map(&rays, &poses, config, world.resolution(), &mut r)?;
+            Ok(RobotMap {
+                map,
+                map_to_world,
+                path: poses.iter().map(|p| p.pos).collect(),
+            })
+        })
+        .collect::<Result<Vec<_>>>()?;
     let overlaps = overlap::overlap_matrix(&explored_masks(&world, &robots), n);
     let achieved = overlap::mean_consecutive(&overlaps);
     if (achieved - config.overlap).abs() > config.overlap_tolerance {
