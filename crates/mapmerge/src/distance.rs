@@ -209,7 +209,11 @@ mod tests {
         let mut cells = vec![UNKNOWN; w * h];
         for y in 20..28 {
             for x in 30..42 {
-                cells[y * w + x] = if (x == 30 && y < 25) || (y == 27 && x > 35) { 100 } else { 0 };
+                cells[y * w + x] = if (x == 30 && y < 25) || (y == 27 && x > 35) {
+                    100
+                } else {
+                    0
+                };
             }
         }
         let g = OccupancyGrid::from_cells(w, h, 0.05, Pose2::default(), cells.clone()).unwrap();
