@@ -86,7 +86,7 @@ pub enum UnknownPolicy {
     Drop(f64),
 }
 
-/// Extraction settings. The defaults come from `examples/measure.rs` (synthetic pairs) and from
+/// Extraction settings. The defaults come from `examples/measure_blobs.rs` (synthetic pairs) and from
 /// simulated robot pairs (`mapsim`); each field says what was measured.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BlobConfig {
@@ -110,7 +110,7 @@ pub struct BlobConfig {
     /// Above this `minor / major` eigenvalue ratio a component counts as round and gets no
     /// orientation. Default 0.6: on rigidly warped synthetic maps, true partners with roundness
     /// below 0.6 agree on the rotation within 3 degrees in 85-94 % of cases, above 0.6 in
-    /// 33-71 % (`cargo run --release -p blob-features --example measure`).
+    /// 33-71 % (`cargo run --release -p blob-features --example measure_blobs`).
     pub round_ratio: f64,
     /// Handling of components that border unknown cells. Default [`UnknownPolicy::Downweight`].
     pub unknown: UnknownPolicy,

@@ -11,7 +11,7 @@
 //! kornia-rs: an [`Estimator`], a [`Sampler`], a [`Consensus`] rule and one generic loop,
 //! [`driver::run`]; [`estimate_rigid`] wires the rigid versions together.
 //!
-//! Measured with `cargo run --release -p ransac-rigid --example measure` (synthetic sets,
+//! Measured with `cargo run --release -p ransac-rigid --example measure_ransac` (synthetic sets,
 //! 1 px noise, 100 seeded trials each; CPU times on a loaded 2-core machine):
 //! - 2 000 correspondences with 20 % inliers: 100 % recovered, mean displacement 0.08 px,
 //!   about 2 ms; with 10 inliers in 2 000: 99 % recovered, about 13 ms.

@@ -15,7 +15,7 @@
 //!
 //! # Measurements that chose the defaults
 //!
-//! Command: `cargo run --release -p sift-desc --example measure` (maps from
+//! Command: `cargo run --release -p sift-desc --example measure_sift` (maps from
 //! `/work/shared/maps` or the directories given; `VARIANTS=short` runs only the last block).
 //! Each of the 10 shared maps (real and simulated, 200 x 300 to 1006 x 1674 cells) is paired
 //! with a copy turned by 27° and shifted, in three scenarios: *clean* (exact copy), *noisy*

@@ -1,7 +1,7 @@
 //! Measurements behind the defaults of `BlobConfig` and `MatchConfig`, on synthetic pairs (a
 //! scattered-shape map and a rigidly warped copy).
 //!
-//! `cargo run --release -p blob-features --example measure`
+//! `cargo run --release -p blob-features --example measure_blobs`
 
 #[path = "../tests/common/mod.rs"]
 mod common;

@@ -1,6 +1,6 @@
 //! Measures the design choices of ransac-rigid on synthetic correspondence sets with known
 //! truth: MSAC versus inlier counting, and SIFT-orientation pruning of 2-point hypotheses.
-//! Run: `cargo run --release -p ransac-rigid --example measure`
+//! Run: `cargo run --release -p ransac-rigid --example measure_ransac`
 
 use std::f64::consts::PI;
 use std::time::Instant;

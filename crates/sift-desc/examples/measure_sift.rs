@@ -5,7 +5,7 @@
 //! optionally overlapping A only in part); each configuration's correspondences are scored by
 //! how many agree with the true transform within 2 px.
 //!
-//! Run: `cargo run --release -p sift-desc --example measure -- [MAP_DIR...]`
+//! Run: `cargo run --release -p sift-desc --example measure_sift -- [MAP_DIR...]`
 
 #[path = "../tests/common/mod.rs"]
 mod common;
