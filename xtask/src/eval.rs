@@ -48,6 +48,17 @@ pub struct EvalArgs {
     /// calibration experiments.
     #[arg(long)]
     wall_tolerance: Option<f32>,
+    /// Override SIFT's nearest / second-nearest ratio (default: the library's), for
+    /// calibration experiments.
+    #[arg(long)]
+    sift_ratio: Option<f32>,
+    /// Override how many distinct RANSAC hypotheses are refined and verified (default: the
+    /// library's), for calibration experiments.
+    #[arg(long)]
+    top_k: Option<usize>,
+    /// Only the rows whose label contains this text (e.g. `"overlap 0.3"`).
+    #[arg(long)]
+    only: Option<String>,
 }
 
 /// One row of a suite: a configuration and whether success means declining.
@@ -216,6 +227,9 @@ struct Outcome {
     /// (displacement error in px): what the verification could reach at best.
     truth_verification: Option<mapmerge::verify::Verification>,
     truth_refined_drift_px: Option<f64>,
+    /// Correspondences that agree with the truth (within the RANSAC threshold), by kind: how
+    /// much real evidence hypothesis generation had to work with.
+    true_correspondences: Option<mapmerge::KindTotals>,
 }
 
 /// Generate case `seed` of `row` once and register it with every method.
@@ -239,6 +253,7 @@ fn run_case(row: &Row, methods: &[Method], seed: u64, args: &EvalArgs) -> Vec<Ou
         correspondences: None,
         truth_verification: None,
         truth_refined_drift_px: None,
+        true_correspondences: None,
     };
     let case = match generate_case(&row.config, seed) {
         Ok(c) => c,
@@ -262,6 +277,12 @@ fn run_case(row: &Row, methods: &[Method], seed: u64, args: &EvalArgs) -> Vec<Ou
     }
     if args.no_search {
         defaults.pair.search = None;
+    }
+    if let Some(r) = args.sift_ratio {
+        defaults.sift.ratio = r;
+    }
+    if let Some(k) = args.top_k {
+        defaults.pair.ransac.top_k = k;
     }
     let (truth_verification, truth_refined_drift_px) = if row.expect_decline {
         (None, None)
@@ -306,6 +327,16 @@ fn run_case(row: &Row, methods: &[Method], seed: u64, args: &EvalArgs) -> Vec<Ou
                 .and_then(|c| displacement_error(b, &c.transform, &truth));
             out.timings = Some(result.timings);
             out.correspondences = Some(result.correspondences);
+            let mut agree = mapmerge::KindTotals::default();
+            for c in &result.matches {
+                if (c.a - truth.apply(c.b)).length() <= config.pair.ransac.threshold_px {
+                    match c.kind {
+                        grid_core::EvidenceKind::Intensity => agree.intensity += 1,
+                        grid_core::EvidenceKind::Area => agree.area += 1,
+                    }
+                }
+            }
+            out.true_correspondences = Some(agree);
             if let Some(c) = &result.accepted {
                 out.accepted = true;
                 out.rotation_error_deg = Some(rotation_error_deg(&c.transform, &truth));
@@ -336,10 +367,21 @@ fn fmt_opt(v: Option<f64>, digits: usize) -> String {
 /// Run `cargo xtask eval`.
 pub fn run(args: EvalArgs) -> Result<()> {
     let rows = rows(&args.suites, args.size)?;
-    let jobs: Vec<(usize, u64)> = rows
+    // A row keeps its index among the selected suites' rows with or without `--only`, so the
+    // filtered run draws the same cases as the full one.
+    let selected: Vec<usize> = (0..rows.len())
+        .filter(|&r| {
+            args.only
+                .as_ref()
+                .is_none_or(|o| rows[r].label.contains(o.as_str()))
+        })
+        .collect();
+    if let Some(only) = &args.only {
+        anyhow::ensure!(!selected.is_empty(), "no row label contains {only:?}");
+    }
+    let jobs: Vec<(usize, u64)> = selected
         .iter()
-        .enumerate()
-        .flat_map(|(r, _)| {
+        .flat_map(|&r| {
             (0..args.cases as u64).map(move |k| (r, args.seed * 1_000_000 + r as u64 * 1000 + k))
         })
         .collect();
@@ -365,7 +407,7 @@ pub fn run(args: EvalArgs) -> Result<()> {
         "| suite | case family | method | cases | success | accepted | false accepts | median rot. err (deg) | median disp. err (px) | mean overlap | mean time (ms) |"
     )?;
     writeln!(table, "|---|---|---|---|---|---|---|---|---|---|---|")?;
-    for row in &rows {
+    for row in selected.iter().map(|&r| &rows[r]) {
         for &m in &args.methods {
             let os: Vec<&Outcome> = outcomes
                 .iter()

@@ -167,6 +167,128 @@ fn fft2(data: &mut [Complex32], w: usize, h: usize, planner: &mut FftPlanner<f32
     }
 }
 
+/// A's coarse likelihood field, transformed, with the geometry of the correlation images.
+struct CoarseField {
+    /// Coarse cell size in pixels.
+    scale: f64,
+    /// Side lengths of the (zero-padded) correlation images.
+    nw: usize,
+    nh: usize,
+    /// Fourier transform of A's coarse field.
+    spectrum: Vec<Complex32>,
+}
+
+impl CoarseField {
+    /// A's field at a scale where the larger of A's sides and B's diagonal spans `coarse_size`
+    /// cells, padded so that every shift of B stays unambiguous.
+    fn new(
+        a: &PreparedMap,
+        b: &PreparedMap,
+        coarse_size: usize,
+        planner: &mut FftPlanner<f32>,
+    ) -> Self {
+        let (wa, ha) = (a.grid.width() as f64, a.grid.height() as f64);
+        let diag_b = ((b.grid.width() as f64).powi(2) + (b.grid.height() as f64).powi(2)).sqrt();
+        let scale = (wa.max(ha).max(diag_b) / coarse_size as f64).max(1.0);
+        let (cw, ch) = (
+            (wa / scale).ceil() as usize + 1,
+            (ha / scale).ceil() as usize + 1,
+        );
+        let bside = (diag_b / scale).ceil() as usize + 2;
+        let (nw, nh) = (
+            (cw + bside).next_power_of_two(),
+            (ch + bside).next_power_of_two(),
+        );
+        let field = coarse_field(a, scale, cw, ch);
+        let mut spectrum = vec![Complex32::default(); nw * nh];
+        for y in 0..ch {
+            for x in 0..cw {
+                spectrum[y * nw + x].re = field[y * cw + x];
+            }
+        }
+        fft2(&mut spectrum, nw, nh, planner, false);
+        Self {
+            scale,
+            nw,
+            nh,
+            spectrum,
+        }
+    }
+
+    /// The best `peaks` translations for B's wall points `pb` turned by `theta`: local maxima
+    /// of `C(t) = sum_u F_A(u + t) P_B(u)`, as `(correlation, B→A transform)`, best first.
+    /// `buf` is scratch space of `nw * nh`.
+    fn correlate(
+        &self,
+        pb: &[DVec2],
+        theta: f64,
+        peaks: usize,
+        planner: &mut FftPlanner<f32>,
+        buf: &mut Vec<Complex32>,
+    ) -> Vec<(f32, Rigid2)> {
+        let (nw, nh, scale) = (self.nw, self.nh, self.scale);
+        let rot = DVec2::from_angle(theta);
+        let q: Vec<DVec2> = pb.iter().map(|p| rot.rotate(*p)).collect();
+        let qmin = q
+            .iter()
+            .copied()
+            .fold(DVec2::splat(f64::INFINITY), DVec2::min);
+        buf.clear();
+        buf.resize(nw * nh, Complex32::default());
+        for p in &q {
+            let u = (*p - qmin) / scale;
+            let (ux, uy) = (u.x.round() as usize, u.y.round() as usize);
+            if ux < nw && uy < nh {
+                buf[uy * nw + ux].re = 1.0;
+            }
+        }
+        fft2(buf, nw, nh, planner, false);
+        for (x, y) in buf.iter_mut().zip(&self.spectrum) {
+            *x = y * x.conj();
+        }
+        fft2(buf, nw, nh, planner, true);
+        // Negative shifts are wrapped around.
+        let mut found: Vec<(f32, usize, usize)> = Vec::new();
+        for ty in 0..nh {
+            for tx in 0..nw {
+                let v = buf[ty * nw + tx].re;
+                if v <= 0.0 {
+                    continue;
+                }
+                let is_max = (-1i64..=1).all(|dy| {
+                    (-1i64..=1).all(|dx| {
+                        let (nx, ny) = (
+                            (tx as i64 + dx).rem_euclid(nw as i64),
+                            (ty as i64 + dy).rem_euclid(nh as i64),
+                        );
+                        (dx == 0 && dy == 0) || buf[ny as usize * nw + nx as usize].re <= v
+                    })
+                });
+                if is_max {
+                    found.push((v, tx, ty));
+                }
+            }
+        }
+        found.sort_by(|x, y| y.0.total_cmp(&x.0));
+        // The FFT's values carry a scale of nw * nh; it is the same for every angle.
+        found
+            .iter()
+            .take(peaks)
+            .map(|&(v, tx, ty)| {
+                let wrap = |t: usize, n: usize| {
+                    if t > n / 2 {
+                        t as f64 - n as f64
+                    } else {
+                        t as f64
+                    }
+                };
+                let t = scale * DVec2::new(wrap(tx, nw), wrap(ty, nh)) - qmin;
+                (v, Rigid2::new(theta, t.x, t.y).normalized())
+            })
+            .collect()
+    }
+}
+
 /// Append global-search hypotheses (B→A, pixel convention) to `out`.
 pub fn global_hypotheses(
     a: &PreparedMap,
@@ -186,84 +308,12 @@ pub fn global_hypotheses(
         angles.push(base);
         angles.push(base + PI);
     }
-
-    let (wa, ha) = (a.grid.width() as f64, a.grid.height() as f64);
-    let diag_b = ((b.grid.width() as f64).powi(2) + (b.grid.height() as f64).powi(2)).sqrt();
-    let scale = (wa.max(ha).max(diag_b) / config.coarse_size as f64).max(1.0);
-    let (cw, ch) = (
-        (wa / scale).ceil() as usize + 1,
-        (ha / scale).ceil() as usize + 1,
-    );
-    let bside = (diag_b / scale).ceil() as usize + 2;
-    let (nw, nh) = (
-        (cw + bside).next_power_of_two(),
-        (ch + bside).next_power_of_two(),
-    );
-    let field = coarse_field(a, scale, cw, ch);
     let mut planner = FftPlanner::<f32>::new();
-    let mut fa = vec![Complex32::default(); nw * nh];
-    for y in 0..ch {
-        for x in 0..cw {
-            fa[y * nw + x].re = field[y * cw + x];
-        }
-    }
-    fft2(&mut fa, nw, nh, &mut planner, false);
-
-    let mut fb = vec![Complex32::default(); nw * nh];
+    let field = CoarseField::new(a, b, config.coarse_size, &mut planner);
+    let mut buf = Vec::new();
     for theta in angles {
-        let rot = DVec2::from_angle(theta);
-        let q: Vec<DVec2> = pb.iter().map(|p| rot.rotate(*p)).collect();
-        let qmin = q
-            .iter()
-            .copied()
-            .fold(DVec2::splat(f64::INFINITY), DVec2::min);
-        fb.fill(Complex32::default());
-        for p in &q {
-            let u = (*p - qmin) / scale;
-            let (ux, uy) = (u.x.round() as usize, u.y.round() as usize);
-            if ux < nw && uy < nh {
-                fb[uy * nw + ux].re = 1.0;
-            }
-        }
-        fft2(&mut fb, nw, nh, &mut planner, false);
-        for (x, y) in fb.iter_mut().zip(&fa) {
-            *x = y * x.conj();
-        }
-        fft2(&mut fb, nw, nh, &mut planner, true);
-        // Peaks of C(t) = sum_u F_A(u + t) P_B(u), with negative shifts wrapped around.
-        let mut peaks: Vec<(f32, usize, usize)> = Vec::new();
-        for ty in 0..nh {
-            for tx in 0..nw {
-                let v = fb[ty * nw + tx].re;
-                let is_max = (-1i64..=1).all(|dy| {
-                    (-1i64..=1).all(|dx| {
-                        let (nx, ny) = (
-                            (tx as i64 + dx).rem_euclid(nw as i64),
-                            (ty as i64 + dy).rem_euclid(nh as i64),
-                        );
-                        (dx == 0 && dy == 0) || fb[ny as usize * nw + nx as usize].re <= v
-                    })
-                });
-                if is_max && v > 0.0 {
-                    peaks.push((v, tx, ty));
-                }
-            }
-        }
-        peaks.sort_by(|x, y| y.0.total_cmp(&x.0));
-        for &(_, tx, ty) in peaks.iter().take(config.translation_peaks) {
-            let sx = if tx > nw / 2 {
-                tx as f64 - nw as f64
-            } else {
-                tx as f64
-            };
-            let sy = if ty > nh / 2 {
-                ty as f64 - nh as f64
-            } else {
-                ty as f64
-            };
-            let t = scale * DVec2::new(sx, sy) - qmin;
-            out.push(Rigid2::new(theta, t.x, t.y).normalized());
-        }
+        let found = field.correlate(&pb, theta, config.translation_peaks, &mut planner, &mut buf);
+        out.extend(found.into_iter().map(|(_, t)| t));
     }
 }
 
