@@ -70,12 +70,24 @@ impl ScaleSpace {
             octave.gaussians.resize_with(n_spo + 3, Image::default);
             octave.dogs.resize_with(n_spo + 2, Image::default);
             if o == 0 {
-                // Seed: resample to delta_min, then blur from sigma_in up to sigma_min.
                 let mut seed = std::mem::take(&mut octave.dogs[0]);
-                resample(image, config.delta_min, &mut seed);
                 let extra = (config.sigma_min.powi(2) - config.sigma_in.powi(2)).max(0.0);
-                let kernel = GaussianKernel::new(extra.sqrt() / config.delta_min);
-                gaussian_blur(&seed, &kernel, &mut self.tmp, &mut octave.gaussians[0]);
+                if config.delta_min <= 1.0 {
+                    // Seed: resample to delta_min, then blur from sigma_in up to sigma_min.
+                    resample(image, config.delta_min, &mut seed);
+                    let kernel = GaussianKernel::new(extra.sqrt() / config.delta_min);
+                    gaussian_blur(&seed, &kernel, &mut self.tmp, &mut octave.gaussians[0]);
+                } else {
+                    // Coarser than the input: blur to sigma_min first, then sample, so the
+                    // seed does not alias.
+                    gaussian_blur(
+                        image,
+                        &GaussianKernel::new(extra.sqrt()),
+                        &mut self.tmp,
+                        &mut seed,
+                    );
+                    resample(&seed, config.delta_min, &mut octave.gaussians[0]);
+                }
                 octave.dogs[0] = seed;
             } else {
                 // The first image of an octave is image n_spo of the previous one, decimated.

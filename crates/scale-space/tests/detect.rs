@@ -34,10 +34,12 @@ fn expected_sigma(s0: f32, config: &ScaleSpaceConfig) -> f32 {
 
 #[test]
 fn gaussian_blob_is_found_at_its_centre_and_scale() {
-    for delta_min in [1.0, 0.5] {
+    // The default half-resolution first octave, the IPOL one, and the up-sampled one.
+    for (delta_min, sigma_min) in [(2.0, 1.6), (1.0, 0.8), (0.5, 0.8)] {
         for s0 in [3.0f32, 6.0] {
             let config = ScaleSpaceConfig {
                 delta_min,
+                sigma_min,
                 crop_margin: None,
                 ..ScaleSpaceConfig::default()
             };
@@ -139,9 +141,10 @@ fn keypoints_turn_with_the_image() {
     let n = 257;
     let img = rooms(n);
     let turned = rotate_quarter(&img);
-    for delta_min in [1.0, 0.5] {
+    for (delta_min, sigma_min) in [(2.0, 1.6), (1.0, 0.8), (0.5, 0.8)] {
         let config = ScaleSpaceConfig {
             delta_min,
+            sigma_min,
             crop_margin: None,
             ..ScaleSpaceConfig::default()
         };
@@ -235,4 +238,25 @@ fn cropped_detection_reports_grid_coordinates() {
     );
     assert_eq!(got, Ok(None));
     assert!(out.is_empty());
+}
+
+#[test]
+fn a_coarse_first_octave_needs_enough_blur() {
+    let config = |delta_min, sigma_min| ScaleSpaceConfig {
+        delta_min,
+        sigma_min,
+        ..ScaleSpaceConfig::default()
+    };
+    assert_eq!(ScaleSpaceConfig::default().validate(), Ok(()));
+    assert_eq!(config(2.0, 1.6).validate(), Ok(()));
+    assert_eq!(
+        config(2.0, 0.8).validate(),
+        Err(scale_space::Error::Config(
+            "a first octave coarser than the input (delta_min > 1) needs sigma_min >= 0.8 delta_min, or it aliases"
+        ))
+    );
+    assert_eq!(
+        config(2.5, 2.0).validate(),
+        Err(scale_space::Error::Config("delta_min must be in (0, 2]"))
+    );
 }
