@@ -135,7 +135,8 @@ impl Default for BlobConfig {
 /// An area keypoint: one connected component of obstacle cells.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Blob {
-    /// Label of the component in the label image (`1..=n`).
+    /// Label of the component (`1..=n`) in the label image of the extraction's window (see
+    /// [`BlobScratch::window`]).
     pub label: u32,
     /// Moments and shape statistics.
     pub shape: Shape,
@@ -151,6 +152,10 @@ pub struct Blob {
 /// Caller-owned buffers for [`Blobs::extract_with`], reused across maps.
 #[derive(Debug, Clone, Default)]
 pub struct BlobScratch {
+    /// Top-left cell of the window the buffers cover.
+    origin: (usize, usize),
+    /// Width and height of the window.
+    size: (usize, usize),
     mask: Vec<u8>,
     tmp: Vec<u8>,
     labels: Vec<u32>,
@@ -159,12 +164,20 @@ pub struct BlobScratch {
 }
 
 impl BlobScratch {
-    /// The label image of the last extraction (`0` background), row-major.
+    /// The window of the grid the last extraction worked on, `(x0, y0, width, height)`: the
+    /// known cells' bounding box with a margin; [`Self::labels`] and [`Self::mask`] cover it.
+    pub fn window(&self) -> (usize, usize, usize, usize) {
+        let (w, h) = self.size;
+        (self.origin.0, self.origin.1, w, h)
+    }
+
+    /// The label image of the last extraction (`0` background) over [`Self::window`],
+    /// row-major; a [`Blob::label`] indexes it.
     pub fn labels(&self) -> &[u32] {
         &self.labels
     }
 
-    /// The (closed) obstacle mask of the last extraction, row-major.
+    /// The (closed) obstacle mask of the last extraction over [`Self::window`], row-major.
     pub fn mask(&self) -> &[u8] {
         &self.mask
     }
@@ -191,7 +204,40 @@ impl Blobs {
         out: &mut Vec<Blob>,
     ) {
         let c = &self.config;
-        let (w, h) = (grid.width(), grid.height());
+        // Only the bounding box of the known cells, grown by a margin of unknown cells, can
+        // hold a component: outside it every cell is unknown, which is background in the
+        // occupied mask and, in the not-free mask, part of the surround that touches the border
+        // and is dropped. The margin keeps the closing inside the box as on the whole grid (it
+        // reaches 2 * radius cells), and keeps the surround connected around the box, so the
+        // blobs are exactly those of the whole grid, at a fraction of the cost on a big canvas.
+        scratch.origin = (0, 0);
+        scratch.size = (0, 0);
+        scratch.mask.clear();
+        scratch.labels.clear();
+        let Some((x0, y0, w, h)) = grid.known_bounds(2 * c.close_radius + 2) else {
+            return;
+        };
+        let cropped;
+        let grid = if (w, h) == (grid.width(), grid.height()) {
+            grid
+        } else {
+            let cells: Vec<u8> = grid
+                .cells()
+                .chunks_exact(grid.width())
+                .skip(y0)
+                .take(h)
+                .flat_map(|row| &row[x0..x0 + w])
+                .copied()
+                .collect();
+            let Ok(g) = OccupancyGrid::from_cells(w, h, grid.resolution(), grid.origin(), cells)
+            else {
+                return;
+            };
+            cropped = g;
+            &cropped
+        };
+        scratch.origin = (x0, y0);
+        scratch.size = (w, h);
         match c.mask {
             MaskKind::Occupied => obstacle_mask(grid, &mut scratch.mask),
             MaskKind::NotFreeIslands => not_free_mask(grid, &mut scratch.mask),
@@ -208,15 +254,27 @@ impl Blobs {
         else {
             return;
         };
-        accumulate(&scratch.labels, &scratch.mask, n, grid, &mut scratch.acc);
+        accumulate(
+            &scratch.labels,
+            &scratch.mask,
+            n,
+            grid,
+            (x0, y0),
+            &mut scratch.acc,
+        );
         for (i, acc) in scratch.acc.iter().enumerate() {
             if acc.area() < c.min_area.max(1) {
                 continue;
             }
+            // In the grid's frame; a component touching the window's border touches the
+            // unknown surround.
             let shape = acc.shape();
             let b = &shape.bbox;
             if c.mask == MaskKind::NotFreeIslands
-                && (b.min_x == 0 || b.min_y == 0 || b.max_x + 1 == w || b.max_y + 1 == h)
+                && (b.min_x == x0
+                    || b.min_y == y0
+                    || b.max_x + 1 == x0 + w
+                    || b.max_y + 1 == y0 + h)
             {
                 continue;
             }

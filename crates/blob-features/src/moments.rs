@@ -184,13 +184,16 @@ fn log_scale(h: f64) -> f64 {
 }
 
 /// Accumulate the statistics of every component of `labels` (`1..=n`, `0` background, non-zero
-/// exactly where `mask` is) into `acc` (resized to `n`). `grid` supplies the unknown cells for the contact measure; it must
-/// have the labels' size.
+/// exactly where `mask` is) into `acc` (resized to `n`). `grid` supplies the unknown cells for
+/// the contact measure; it must have the labels' size. `origin` is added to every pixel's
+/// coordinates (the labels may cover a window of a larger grid), so positions come out in the
+/// larger grid's frame, computed exactly as if it had been labelled whole.
 pub(crate) fn accumulate(
     labels: &[u32],
     mask: &[u8],
     n: usize,
     grid: &OccupancyGrid,
+    origin: (usize, usize),
     acc: &mut Vec<Accumulator>,
 ) {
     let (w, h) = (grid.width(), grid.height());
@@ -219,7 +222,7 @@ pub(crate) fn accumulate(
             }
             let x = x - 1;
             let a = &mut acc[l as usize - 1];
-            a.add(x as u32, y as u32);
+            a.add((x + origin.0) as u32, (y + origin.1) as u32);
             let edge = x == 0 || y == 0 || x + 1 == w || y + 1 == h;
             let boundary = edge
                 || row[x - 1] != l

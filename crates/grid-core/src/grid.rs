@@ -227,6 +227,34 @@ impl OccupancyGrid {
         &mut self.cells
     }
 
+    /// The bounding box `(x0, y0, width, height)` of the known (free or occupied, per
+    /// [`Self::classify`]) cells, grown by `margin` cells on each side and clipped to the grid;
+    /// `None` when no cell is known. Everything outside it is unknown, so work that only
+    /// concerns known cells can skip the rest of a big canvas.
+    pub fn known_bounds(&self, margin: usize) -> Option<(usize, usize, usize, usize)> {
+        let (w, h) = (self.width(), self.height());
+        let known = |c: &u8| Self::classify(*c) != CellState::Unknown;
+        let (mut x0, mut y0, mut x1, mut y1) = (usize::MAX, usize::MAX, 0usize, 0usize);
+        for (y, row) in self.cells.chunks_exact(w.max(1)).enumerate() {
+            if let Some(first) = row.iter().position(known) {
+                let last = row.iter().rposition(known).unwrap_or(first);
+                x0 = x0.min(first);
+                x1 = x1.max(last);
+                y0 = y0.min(y);
+                y1 = y1.max(y);
+            }
+        }
+        if x0 == usize::MAX {
+            return None;
+        }
+        let (x0, y0) = (x0.saturating_sub(margin), y0.saturating_sub(margin));
+        let (x1, y1) = (
+            x1.saturating_add(margin).min(w - 1),
+            y1.saturating_add(margin).min(h - 1),
+        );
+        Some((x0, y0, x1 - x0 + 1, y1 - y0 + 1))
+    }
+
     /// Raw cell value at column `x`, row `y`, or `None` outside the grid.
     #[inline]
     pub fn get(&self, x: usize, y: usize) -> Option<u8> {
@@ -322,6 +350,23 @@ impl OccupancyGrid {
 mod tests {
     use super::*;
     use proptest::prelude::*;
+
+    #[test]
+    fn known_bounds_cover_free_and_occupied_cells_only() {
+        let (w, h) = (20, 10);
+        let mut cells = vec![UNKNOWN; w * h];
+        cells[3 * w + 5] = 0; // free
+        cells[6 * w + 12] = 100; // occupied
+        cells[8 * w + 18] = 50; // between the thresholds: unknown to classify
+        let g = OccupancyGrid::from_cells(w, h, 0.05, Pose2::default(), cells).unwrap();
+        assert_eq!(g.known_bounds(0), Some((5, 3, 8, 4)));
+        // Grown by 2, and clipped where the grid ends.
+        assert_eq!(g.known_bounds(2), Some((3, 1, 12, 8)));
+        assert_eq!(g.known_bounds(100), Some((0, 0, w, h)));
+        let empty =
+            OccupancyGrid::from_cells(w, h, 0.05, Pose2::default(), vec![UNKNOWN; w * h]).unwrap();
+        assert_eq!(empty.known_bounds(3), None);
+    }
 
     #[test]
     fn zero_size_is_refused() {

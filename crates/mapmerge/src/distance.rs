@@ -127,29 +127,8 @@ impl NearestOccupied {
 /// Bounding box `(x0, y0, width, height)` of the known cells of `grid` (the whole grid when
 /// none is known, which the loaders refuse anyway).
 pub fn known_window(grid: &OccupancyGrid) -> (usize, usize, usize, usize) {
-    let (w, h) = (grid.width(), grid.height());
-    let (mut x0, mut y0, mut x1, mut y1) = (usize::MAX, usize::MAX, 0, 0);
-    for (y, row) in grid.cells().chunks_exact(w).enumerate() {
-        let mut known = row.iter().map(|&c| c != grid_core::UNKNOWN);
-        let Some(first) = known.position(|k| k) else {
-            continue;
-        };
-        let last = w
-            - 1
-            - row
-                .iter()
-                .rev()
-                .position(|&c| c != grid_core::UNKNOWN)
-                .unwrap_or(0);
-        x0 = x0.min(first);
-        x1 = x1.max(last);
-        y0 = y0.min(y);
-        y1 = y1.max(y);
-    }
-    if x0 == usize::MAX {
-        return (0, 0, w, h);
-    }
-    (x0, y0, x1 - x0 + 1, y1 - y0 + 1)
+    grid.known_bounds(0)
+        .unwrap_or((0, 0, grid.width(), grid.height()))
 }
 
 #[cfg(test)]

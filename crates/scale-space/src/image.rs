@@ -116,28 +116,12 @@ pub struct CropRect {
 /// The bounding box of the known (free or occupied) cells grown by `margin` on each side and
 /// clipped to the grid; `None` when no cell is known.
 pub fn known_bounding_box(grid: &OccupancyGrid, margin: usize) -> Option<CropRect> {
-    let (w, h) = (grid.width(), grid.height());
-    let (mut x0, mut y0, mut x1, mut y1) = (usize::MAX, usize::MAX, 0usize, 0usize);
-    for (y, row) in grid.cells().chunks_exact(w).enumerate() {
-        let known = |c: &u8| OccupancyGrid::classify(*c) != CellState::Unknown;
-        if let Some(first) = row.iter().position(known) {
-            let last = row.iter().rposition(known).unwrap_or(first);
-            x0 = x0.min(first);
-            x1 = x1.max(last);
-            y0 = y0.min(y);
-            y1 = y1.max(y);
-        }
-    }
-    if x0 == usize::MAX {
-        return None;
-    }
-    let (x0, y0) = (x0.saturating_sub(margin), y0.saturating_sub(margin));
-    let (x1, y1) = ((x1 + margin).min(w - 1), (y1 + margin).min(h - 1));
+    let (x0, y0, width, height) = grid.known_bounds(margin)?;
     Some(CropRect {
         x0,
         y0,
-        width: x1 - x0 + 1,
-        height: y1 - y0 + 1,
+        width,
+        height,
     })
 }
 
