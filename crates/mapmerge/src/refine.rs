@@ -10,8 +10,9 @@
 //! robustly (Cauchy), so smeared walls of a noisy sensor do not bias the fit.
 
 use grid_core::{CellState, DVec2, Rigid2};
+use rayon::prelude::*;
 
-use crate::verify::PreparedMap;
+use crate::verify::{PreparedMap, strided};
 
 /// Parameters of the refinement, with documented defaults.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -32,6 +33,12 @@ pub struct RefineConfig {
     /// The refinement may move the hypothesis at most this far (pixels, at B's centroid) before
     /// it is considered diverged and the input is kept. Default 8.
     pub max_shift_px: f64,
+    /// Wall cells used per map (evenly strided from the verification's samples). Default
+    /// 6000: on `cargo xtask eval --suites overlap,zero,paper,real --cases 20 --seed 7` every
+    /// row registered the same pairs as with all 20 000 samples (medians moved by at most
+    /// 0.06 px), and refinement on the 2048 x 2048 bench pair (20 000 samples per map) costs a
+    /// third as much.
+    pub max_points: usize,
 }
 
 impl Default for RefineConfig {
@@ -42,6 +49,7 @@ impl Default for RefineConfig {
             max_iterations: 30,
             robust_scale_px: 0.15,
             max_shift_px: 8.0,
+            max_points: 6000,
         }
     }
 }
@@ -57,14 +65,38 @@ struct Pair {
 /// pixels to `onto`'s. With `swap`, the pair is expressed the other way round (A point as
 /// target, B point as source) so both directions feed one system in A's frame.
 fn collect(
-    from: &PreparedMap,
+    from: &[DVec2],
     onto: &PreparedMap,
     to_onto: &Rigid2,
     gate: f32,
     swap: Option<&Rigid2>,
     out: &mut Vec<Pair>,
 ) {
-    for &p in &from.wall_samples {
+    // Chunks are looked up in parallel and appended in order, so the pairs (and the sums over
+    // them) do not depend on the thread count.
+    let chunks: Vec<Vec<Pair>> = from
+        .par_chunks(2048)
+        .map(|chunk| {
+            let mut part = Vec::with_capacity(chunk.len());
+            collect_chunk(chunk, onto, to_onto, gate, swap, &mut part);
+            part
+        })
+        .collect();
+    for part in chunks {
+        out.extend(part);
+    }
+}
+
+/// [`collect`] for some of `from`'s wall samples.
+fn collect_chunk(
+    samples: &[DVec2],
+    onto: &PreparedMap,
+    to_onto: &Rigid2,
+    gate: f32,
+    swap: Option<&Rigid2>,
+    out: &mut Vec<Pair>,
+) {
+    for &p in samples {
         let m = to_onto.apply(p);
         let (x, y) = (m.x.round(), m.y.round());
         if x < 0.0 || y < 0.0 {
@@ -127,14 +159,18 @@ fn solve3(m: [[f64; 3]; 3], v: [f64; 3]) -> Option<[f64; 3]> {
 /// found or the refinement wanders off.
 pub fn refine(a: &PreparedMap, b: &PreparedMap, b_to_a: &Rigid2, config: &RefineConfig) -> Rigid2 {
     let mut t = *b_to_a;
-    let mut pairs = Vec::with_capacity(a.wall_samples.len() + b.wall_samples.len());
+    let (wa, wb) = (
+        strided(&a.wall_samples, config.max_points),
+        strided(&b.wall_samples, config.max_points),
+    );
+    let mut pairs = Vec::with_capacity(wa.len() + wb.len());
     for it in 0..config.max_iterations {
         let f = (it as f32 / (config.max_iterations.max(2) / 2) as f32).min(1.0);
         let gate = config.initial_gate_px + (config.final_gate_px - config.initial_gate_px) * f;
         let scale = config.robust_scale_px;
         pairs.clear();
-        collect(b, a, &t, gate, None, &mut pairs);
-        collect(a, b, &t.inverse(), gate, Some(&t), &mut pairs);
+        collect(&wb, a, &t, gate, None, &mut pairs);
+        collect(&wa, b, &t.inverse(), gate, Some(&t), &mut pairs);
         if pairs.len() < 10 {
             break;
         }

@@ -197,14 +197,18 @@ pub fn register_with(
                 let transform = refine(&pa, &pb, start, refine_config).normalized();
                 (transform, verify(&pa, &pb, &transform, &config.verify))
             };
-            let (mut transform, mut verification) = polish(model);
-            if let Some(sc) = search {
-                let moved = local_search(&pa, &pb, model, sc);
-                if moved != *model {
-                    let (t, v) = polish(&moved);
-                    if v.score() > verification.score() {
-                        (transform, verification) = (t, v);
-                    }
+            // The two polishes are independent: run them side by side.
+            let ((mut transform, mut verification), searched) = rayon::join(
+                || polish(model),
+                || {
+                    let sc = search?;
+                    let moved = local_search(&pa, &pb, model, sc);
+                    (moved != *model).then(|| polish(&moved))
+                },
+            );
+            if let Some((t, v)) = searched {
+                if v.score() > verification.score() {
+                    (transform, verification) = (t, v);
                 }
             }
             Candidate {
