@@ -216,7 +216,7 @@ impl CoarseField {
     }
 
     /// The best `peaks` translations for B's wall points `pb` turned by `theta`: local maxima
-    /// of `C(t) = sum_u F_A(u + t) P_B(u)`, as `(correlation, B→A transform)`, best first.
+    /// of `C(t) = sum_u F_A(u + t) P_B(u)`, as B→A transforms, best first.
     /// `buf` is scratch space of `nw * nh`.
     fn correlate(
         &self,
@@ -225,7 +225,7 @@ impl CoarseField {
         peaks: usize,
         planner: &mut FftPlanner<f32>,
         buf: &mut Vec<Complex32>,
-    ) -> Vec<(f32, Rigid2)> {
+    ) -> Vec<Rigid2> {
         let (nw, nh, scale) = (self.nw, self.nh, self.scale);
         let rot = DVec2::from_angle(theta);
         let q: Vec<DVec2> = pb.iter().map(|p| rot.rotate(*p)).collect();
@@ -270,11 +270,10 @@ impl CoarseField {
             }
         }
         found.sort_by(|x, y| y.0.total_cmp(&x.0));
-        // The FFT's values carry a scale of nw * nh; it is the same for every angle.
         found
             .iter()
             .take(peaks)
-            .map(|&(v, tx, ty)| {
+            .map(|&(_, tx, ty)| {
                 let wrap = |t: usize, n: usize| {
                     if t > n / 2 {
                         t as f64 - n as f64
@@ -283,7 +282,7 @@ impl CoarseField {
                     }
                 };
                 let t = scale * DVec2::new(wrap(tx, nw), wrap(ty, nh)) - qmin;
-                (v, Rigid2::new(theta, t.x, t.y).normalized())
+                Rigid2::new(theta, t.x, t.y).normalized()
             })
             .collect()
     }
@@ -312,8 +311,7 @@ pub fn global_hypotheses(
     let field = CoarseField::new(a, b, config.coarse_size, &mut planner);
     let mut buf = Vec::new();
     for theta in angles {
-        let found = field.correlate(&pb, theta, config.translation_peaks, &mut planner, &mut buf);
-        out.extend(found.into_iter().map(|(_, t)| t));
+        out.extend(field.correlate(&pb, theta, config.translation_peaks, &mut planner, &mut buf));
     }
 }
 
