@@ -232,8 +232,26 @@ struct Outcome {
     true_correspondences: Option<mapmerge::KindTotals>,
 }
 
+/// The registration settings the flags describe (the library's defaults unless overridden).
+fn register_config(args: &EvalArgs) -> RegisterConfig {
+    let mut config = RegisterConfig::default();
+    if let Some(t) = args.wall_tolerance {
+        config.pair.verify.wall_tolerance_px = t;
+    }
+    if args.no_search {
+        config.pair.search = None;
+    }
+    if let Some(r) = args.sift_ratio {
+        config.sift.ratio = r;
+    }
+    if let Some(k) = args.top_k {
+        config.pair.ransac.top_k = k;
+    }
+    config
+}
+
 /// Generate case `seed` of `row` once and register it with every method.
-fn run_case(row: &Row, methods: &[Method], seed: u64, args: &EvalArgs) -> Vec<Outcome> {
+fn run_case(row: &Row, methods: &[Method], seed: u64, defaults: &RegisterConfig) -> Vec<Outcome> {
     let blank = |method: Method| Outcome {
         suite: row.suite,
         row: row.label.clone(),
@@ -271,19 +289,6 @@ fn run_case(row: &Row, methods: &[Method], seed: u64, args: &EvalArgs) -> Vec<Ou
     let truth = case.truth(0, 1);
     // What the verification and the refinement reach at best, started at the truth; the
     // same for every method.
-    let mut defaults = RegisterConfig::default();
-    if let Some(t) = args.wall_tolerance {
-        defaults.pair.verify.wall_tolerance_px = t;
-    }
-    if args.no_search {
-        defaults.pair.search = None;
-    }
-    if let Some(r) = args.sift_ratio {
-        defaults.sift.ratio = r;
-    }
-    if let Some(k) = args.top_k {
-        defaults.pair.ransac.top_k = k;
-    }
     let (truth_verification, truth_refined_drift_px) = if row.expect_decline {
         (None, None)
     } else {
@@ -321,22 +326,14 @@ fn run_case(row: &Row, methods: &[Method], seed: u64, args: &EvalArgs) -> Vec<Ou
                 .iter()
                 .map(|c| (c.verification, displacement_error(b, &c.transform, &truth)))
                 .collect();
-            out.best_displacement_error_px = out
-                .best
-                .as_ref()
-                .and_then(|c| displacement_error(b, &c.transform, &truth));
+            out.best_displacement_error_px = out.candidates.first().and_then(|c| c.1);
             out.timings = Some(result.timings);
             out.correspondences = Some(result.correspondences);
-            let mut agree = mapmerge::KindTotals::default();
-            for c in &result.matches {
-                if (c.a - truth.apply(c.b)).length() <= config.pair.ransac.threshold_px {
-                    match c.kind {
-                        grid_core::EvidenceKind::Intensity => agree.intensity += 1,
-                        grid_core::EvidenceKind::Area => agree.area += 1,
-                    }
-                }
-            }
-            out.true_correspondences = Some(agree);
+            let m = &result.matches;
+            let agree = (0..m.len()).filter(|&i| {
+                (m[i].a - truth.apply(m[i].b)).length() <= config.pair.ransac.threshold_px
+            });
+            out.true_correspondences = Some(mapmerge::KindTotals::of(m, agree));
             if let Some(c) = &result.accepted {
                 out.accepted = true;
                 out.rotation_error_deg = Some(rotation_error_deg(&c.transform, &truth));
@@ -367,6 +364,7 @@ fn fmt_opt(v: Option<f64>, digits: usize) -> String {
 /// Run `cargo xtask eval`.
 pub fn run(args: EvalArgs) -> Result<()> {
     let rows = rows(&args.suites, args.size)?;
+    let defaults = register_config(&args);
     // A row keeps its index among the selected suites' rows with or without `--only`, so the
     // filtered run draws the same cases as the full one.
     let selected: Vec<usize> = (0..rows.len())
@@ -394,7 +392,7 @@ pub fn run(args: EvalArgs) -> Result<()> {
     let outcomes: Vec<Outcome> = jobs
         .par_iter()
         .flat_map_iter(|&(r, seed)| {
-            let o = run_case(&rows[r], &args.methods, seed, &args);
+            let o = run_case(&rows[r], &args.methods, seed, &defaults);
             bar.inc(1);
             o
         })

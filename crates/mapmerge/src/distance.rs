@@ -29,7 +29,10 @@ pub struct NearestOccupied {
 impl NearestOccupied {
     /// Build the transform of `grid`'s occupied cells.
     pub fn new(grid: &OccupancyGrid) -> Self {
-        let (x0, y0, w, h) = known_window(grid);
+        // The loaders refuse maps without known cells; a grid built in code gets the whole grid.
+        let (x0, y0, w, h) = grid
+            .known_bounds(0)
+            .unwrap_or((0, 0, grid.width(), grid.height()));
         let mut nearest = vec![NONE; w * h];
         let mut distance = vec![f32::INFINITY; w * h];
         let gw = grid.width();
@@ -92,9 +95,10 @@ impl NearestOccupied {
         }
     }
 
-    /// Window index of grid cell `(x, y)`, if it lies in the window.
+    /// Window index of grid cell `(x, y)`, if it lies in the window (the layout of every
+    /// per-cell array computed over [`Self::window`]).
     #[inline]
-    fn index(&self, x: usize, y: usize) -> Option<usize> {
+    pub(crate) fn index(&self, x: usize, y: usize) -> Option<usize> {
         let (x, y) = (x.wrapping_sub(self.x0), y.wrapping_sub(self.y0));
         (x < self.width && y < self.height).then(|| y * self.width + x)
     }
@@ -122,13 +126,6 @@ impl NearestOccupied {
     pub fn distance(&self, x: usize, y: usize) -> f32 {
         self.index(x, y).map_or(f32::INFINITY, |i| self.distance[i])
     }
-}
-
-/// Bounding box `(x0, y0, width, height)` of the known cells of `grid` (the whole grid when
-/// none is known, which the loaders refuse anyway).
-pub fn known_window(grid: &OccupancyGrid) -> (usize, usize, usize, usize) {
-    grid.known_bounds(0)
-        .unwrap_or((0, 0, grid.width(), grid.height()))
 }
 
 #[cfg(test)]

@@ -20,7 +20,7 @@ pub struct PairConfig {
     /// RANSAC settings (seed included: the result is deterministic for a seed).
     pub ransac: RansacConfig,
     /// Correlative local search around each hypothesis before ICP; `None` disables it.
-    /// Default: on, [`SearchConfig::default`] (+-8 px, +-2 degrees).
+    /// Default: on, [`SearchConfig::default`] (+-8 px, translation only).
     pub search: Option<SearchConfig>,
     /// ICP refinement of each feature-based candidate.
     pub refine: RefineConfig,
@@ -114,7 +114,8 @@ pub struct KindTotals {
 }
 
 impl KindTotals {
-    fn of(corrs: &[Correspondence], indices: impl Iterator<Item = usize>) -> Self {
+    /// Count the correspondences `indices` of `corrs` by kind.
+    pub fn of(corrs: &[Correspondence], indices: impl Iterator<Item = usize>) -> Self {
         let mut t = Self::default();
         for i in indices {
             match corrs[i].kind {
@@ -187,45 +188,44 @@ pub fn register_with(
         .unwrap_or_default();
 
     let t0 = Instant::now();
-    // Each hypothesis is polished by ICP, and feature hypotheses also from the best pose of the
-    // correlative local search around them (their keypoints can put them a few pixels off,
-    // outside ICP's narrow basin); the polished pose the maps agree with more wins. Global
-    // hypotheses come from a grid and have their own wide-gate refinement instead.
-    let check =
-        |model: &Rigid2, refine_config: &RefineConfig, search: Option<&SearchConfig>, origin| {
-            let polish = |start: &Rigid2| {
-                let transform = refine(&pa, &pb, start, refine_config).normalized();
-                (transform, verify(&pa, &pb, &transform, &config.verify))
-            };
-            // The two polishes are independent: run them side by side.
-            let ((mut transform, mut verification), searched) = rayon::join(
-                || polish(model),
-                || {
-                    let sc = search?;
-                    let moved = local_search(&pa, &pb, model, sc);
-                    (moved != *model).then(|| polish(&moved))
-                },
-            );
-            if let Some((t, v)) = searched {
-                if v.score() > verification.score() {
-                    (transform, verification) = (t, v);
-                }
-            }
-            Candidate {
-                transform,
-                ransac_inliers: 0,
-                ransac_confidence: 0.0,
-                accepted: verification.accepted(&config.verify),
-                verification,
-                origin,
-            }
+    // Each hypothesis is polished by ICP, once from itself and once from the best pose of the
+    // correlative local search around it (keypoints, or the global search's coarse grid, can
+    // put it a few pixels off, outside ICP's narrow basin); the polished pose the maps agree
+    // with more wins. Global hypotheses refine with their own, wider-gated configuration.
+    let check = |model: &Rigid2, refine_config: &RefineConfig, origin| {
+        let polish = |start: &Rigid2| {
+            let transform = refine(&pa, &pb, start, refine_config).normalized();
+            (transform, verify(&pa, &pb, &transform, &config.verify))
         };
+        // The two polishes are independent: run them side by side.
+        let ((mut transform, mut verification), searched) = rayon::join(
+            || polish(model),
+            || {
+                let sc = config.search.as_ref()?;
+                let moved = local_search(&pa, &pb, model, sc);
+                (moved != *model).then(|| polish(&moved))
+            },
+        );
+        if let Some((t, v)) = searched {
+            if v.score() > verification.score() {
+                (transform, verification) = (t, v);
+            }
+        }
+        Candidate {
+            transform,
+            ransac_inliers: 0,
+            ransac_confidence: 0.0,
+            accepted: verification.accepted(&config.verify),
+            verification,
+            origin,
+        }
+    };
     let mut candidates: Vec<Candidate> = hypotheses
         .iter()
         .map(|h| Candidate {
             ransac_inliers: h.inliers_count,
             ransac_confidence: h.confidence,
-            ..check(&h.model, &config.refine, config.search.as_ref(), "ransac")
+            ..check(&h.model, &config.refine, "ransac")
         })
         .collect();
     timings.verify_ms = ms(t0);
@@ -237,7 +237,7 @@ pub fn register_with(
             candidates.extend(
                 models
                     .iter()
-                    .map(|m| check(m, &config.global_refine, config.search.as_ref(), "global")),
+                    .map(|m| check(m, &config.global_refine, "global")),
             );
             timings.global_ms = ms(t0);
         }

@@ -158,12 +158,7 @@ impl<'a> PreparedMap<'a> {
     /// Unit normal of the wall at occupied cell `(x, y)`, if it has a clear direction.
     #[inline]
     pub fn normal(&self, x: usize, y: usize) -> Option<DVec2> {
-        let (x0, y0, ww, wh) = self.walls.window();
-        let (x, y) = (x.wrapping_sub(x0), y.wrapping_sub(y0));
-        if x >= ww || y >= wh {
-            return None;
-        }
-        let a = self.normals[y * ww + x];
+        let a = self.normals[self.walls.index(x, y)?];
         (!a.is_nan()).then(|| DVec2::from_angle(a as f64))
     }
 }
