@@ -166,6 +166,13 @@ fn header_claiming_a_huge_image_is_refused_before_allocating() {
         &path,
         "image is 100000 x 100000 pixels (10000000000 cells), more than the limit of 100000000 cells",
     );
+    // Few cells but one very long side: refused too (the pipeline indexes rows and columns
+    // with 20 bits).
+    let path = write(&dir, "long.pgm", b"P5\n2000000 1\n255\n\x00");
+    assert_fails(
+        &path,
+        "image is 2000000 x 1 pixels, a side longer than the limit of 1048576 pixels",
+    );
     let path = write(&dir, "digits.pgm", b"P5\n99999999999999999999 1\n255\n");
     assert_fails(&path, "bad PNM header: width is too large");
     // The limit is an option.

@@ -51,7 +51,8 @@ impl NearestOccupied {
     /// Build the transform of `grid`'s occupied cells.
     ///
     /// # Panics
-    /// When the known window has `u32::MAX` cells or more, or a side longer than 2^20 cells.
+    /// When the known window has `u32::MAX` cells or more, or a side longer than 2^20 cells
+    /// (the loaders refuse such maps: [`grid_core::io::MAX_SIDE`]).
     pub fn new(grid: &OccupancyGrid) -> Self {
         // The loaders refuse maps without known cells; a grid built in code gets the whole grid.
         let (x0, y0, w, h) = grid

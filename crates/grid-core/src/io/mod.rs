@@ -32,6 +32,7 @@ use std::path::{Path, PathBuf};
 
 use crate::{Error, OccupancyGrid, Pose2, Result};
 
+pub use pnm::MAX_SIDE;
 pub use save::{image_path_for, save_map, write_atomic};
 pub use yaml::{MapMetadata, MapMode};
 

@@ -125,12 +125,25 @@ pub(super) fn read_pnm(r: &mut impl BufRead, path: &Path, max_cells: usize) -> R
     })
 }
 
+/// Longest side of a map the pipeline accepts, in cells (2^20: 52 km at 5 cm). The distance
+/// transforms index cells with 32-bit integers and square coordinates in 64-bit ones.
+pub const MAX_SIDE: usize = 1 << 20;
+
 /// Refuse zero-size and too large images, before anything is allocated for them.
 pub(super) fn check_size(path: &Path, width: u64, height: u64, max_cells: usize) -> Result<()> {
     if width == 0 || height == 0 {
         return Err(format_error(
             path,
             format!("image is empty ({width} x {height} pixels)"),
+        ));
+    }
+    if width.max(height) > MAX_SIDE as u64 {
+        return Err(format_error(
+            path,
+            format!(
+                "image is {width} x {height} pixels, a side longer than the limit of {MAX_SIDE} \
+                 pixels"
+            ),
         ));
     }
     let cells = width.saturating_mul(height);
