@@ -216,8 +216,8 @@ impl CoarseField {
     }
 
     /// The best `peaks` translations for B's wall points `pb` turned by `theta`: local maxima
-    /// of `C(t) = sum_u F_A(u + t) P_B(u)`, as B→A transforms, best first.
-    /// `buf` is scratch space of `nw * nh`.
+    /// of `C(t) = sum_u F_A(u + t) P_B(u)`, as B→A transforms with their correlation, best
+    /// first. `buf` is scratch space of `nw * nh`.
     fn correlate(
         &self,
         pb: &[DVec2],
@@ -225,7 +225,7 @@ impl CoarseField {
         peaks: usize,
         planner: &mut FftPlanner<f32>,
         buf: &mut Vec<Complex32>,
-    ) -> Vec<Rigid2> {
+    ) -> Vec<(f32, Rigid2)> {
         let (nw, nh, scale) = (self.nw, self.nh, self.scale);
         let rot = DVec2::from_angle(theta);
         let q: Vec<DVec2> = pb.iter().map(|p| rot.rotate(*p)).collect();
@@ -273,7 +273,7 @@ impl CoarseField {
         found
             .iter()
             .take(peaks)
-            .map(|&(_, tx, ty)| {
+            .map(|&(v, tx, ty)| {
                 let wrap = |t: usize, n: usize| {
                     if t > n / 2 {
                         t as f64 - n as f64
@@ -282,7 +282,7 @@ impl CoarseField {
                     }
                 };
                 let t = scale * DVec2::new(wrap(tx, nw), wrap(ty, nh)) - qmin;
-                Rigid2::new(theta, t.x, t.y).normalized()
+                (v, Rigid2::new(theta, t.x, t.y).normalized())
             })
             .collect()
     }
@@ -311,13 +311,144 @@ pub fn global_hypotheses(
     let field = CoarseField::new(a, b, config.coarse_size, &mut planner);
     let mut buf = Vec::new();
     for theta in angles {
-        out.extend(field.correlate(&pb, theta, config.translation_peaks, &mut planner, &mut buf));
+        let found = field.correlate(&pb, theta, config.translation_peaks, &mut planner, &mut buf);
+        out.extend(found.into_iter().map(|(_, t)| t));
     }
+}
+
+/// Parameters of the rotation sweep, with documented defaults.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SweepConfig {
+    /// Angle step of the sweep over the full turn, in degrees. Default 2.
+    pub step_deg: f64,
+    /// Longest side of the coarse correlation images, in coarse cells. Default 96 (about 5 px
+    /// per cell for the 400 x 400 simulated maps): coarse enough to be cheap and to absorb
+    /// walls that a noisy sensor smeared over several pixels.
+    pub coarse_size: usize,
+    /// Wall points of B correlated at most. Default 4000.
+    pub max_points: usize,
+    /// Placements kept, best correlation first, pairwise distinct (see `distinct_px`).
+    /// Default 8.
+    pub keep: usize,
+    /// Two placements are distinct when B's wall centre lands this far apart under them, or
+    /// their angles differ by more than twice the step. Default 12 px.
+    pub distinct_px: f64,
+}
+
+impl Default for SweepConfig {
+    fn default() -> Self {
+        Self {
+            step_deg: 2.0,
+            coarse_size: 96,
+            max_points: 4000,
+            keep: 8,
+            distinct_px: 12.0,
+        }
+    }
+}
+
+/// Append rotation-sweep hypotheses (B→A, pixel convention) to `out`: for every angle of a
+/// full turn, in steps of `step_deg`, the best translation of B's turned walls on A's coarse
+/// wall field (FFT correlation, as in [`global_hypotheses`]); then the `keep` best distinct
+/// placements over all angles.
+///
+/// Unlike the Hough spectrum, which reads the rotation off the maps' dominant wall directions
+/// and fails when the shared part is small next to the rest, the sweep tries every angle; it
+/// costs one FFT correlation per angle (180 at the default step), so [`crate::register_with`]
+/// runs it last, only when nothing else passed verification. Deterministic: the angles are
+/// independent and their results are merged in angle order.
+pub fn sweep_hypotheses(
+    a: &PreparedMap,
+    b: &PreparedMap,
+    config: &SweepConfig,
+    out: &mut Vec<Rigid2>,
+) {
+    use rayon::prelude::*;
+    let pb = strided(&b.wall_samples, config.max_points);
+    if pb.len() < 10
+        || a.wall_samples.len() < 10
+        || !config.step_deg.is_finite()
+        || config.step_deg <= 0.0
+    {
+        return;
+    }
+    let field = CoarseField::new(a, b, config.coarse_size, &mut FftPlanner::new());
+    let steps = (360.0 / config.step_deg).round().max(1.0) as usize;
+    let found: Vec<(f32, Rigid2)> = (0..steps)
+        .into_par_iter()
+        .map_init(
+            || (FftPlanner::<f32>::new(), Vec::new()),
+            |(planner, buf), k| {
+                let theta = (k as f64 * 2.0 * PI / steps as f64) - PI;
+                field.correlate(&pb, theta, 1, planner, buf)
+            },
+        )
+        .flatten_iter()
+        .collect();
+    let centre = pb.iter().copied().sum::<DVec2>() / pb.len() as f64;
+    let mut order: Vec<usize> = (0..found.len()).collect();
+    // Stable: ties keep angle order.
+    order.sort_by(|&i, &j| found[j].0.total_cmp(&found[i].0));
+    let mut kept: Vec<Rigid2> = Vec::new();
+    for i in order {
+        if kept.len() >= config.keep {
+            break;
+        }
+        let t = found[i].1;
+        let distinct = kept.iter().all(|k| {
+            grid_core::wrap_angle(k.theta - t.theta).abs() > 2.0 * config.step_deg.to_radians()
+                || (k.apply(centre) - t.apply(centre)).length() > config.distinct_px
+        });
+        if distinct {
+            kept.push(t);
+        }
+    }
+    out.extend(kept);
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::testmaps::room;
+    use crate::verify::VerifyConfig;
+
+    #[test]
+    fn the_sweep_finds_a_turned_copy_and_is_deterministic() {
+        let a = room();
+        let vc = VerifyConfig::default();
+        let pa = PreparedMap::new(&a, &vc);
+        for deg in [137.0f64, -61.0, 3.0] {
+            // B is A turned by `deg` and shifted onto a larger canvas; the truth maps B to A.
+            let a_to_b = Rigid2::new(deg.to_radians(), 110.0, 30.0);
+            let b = a.warp(&a_to_b, 240, 220).unwrap();
+            let truth = a_to_b.inverse();
+            let pb = PreparedMap::new(&b, &vc);
+            let run = |threads| {
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .unwrap()
+                    .install(|| {
+                        let mut out = Vec::new();
+                        sweep_hypotheses(&pa, &pb, &SweepConfig::default(), &mut out);
+                        out
+                    })
+            };
+            let found = run(2);
+            assert_eq!(found, run(1), "the thread count changed the answer");
+            assert!(found.len() <= SweepConfig::default().keep);
+            // Within what a 2-degree step and 5-pixel cells allow: the refinement takes it
+            // from there.
+            let best = found
+                .iter()
+                .map(|t| grid_core::metrics::displacement_error(&b, t, &truth).unwrap())
+                .fold(f64::INFINITY, f64::min);
+            assert!(best < 6.0, "{deg} deg: nearest placement {best} px off");
+            // and it is the strongest correlation, not a lucky runner-up.
+            let first = grid_core::metrics::displacement_error(&b, &found[0], &truth).unwrap();
+            assert!(first < 6.0, "{deg} deg: first placement {first} px off");
+        }
+    }
 
     #[test]
     fn spectrum_correlation_finds_the_rotation() {

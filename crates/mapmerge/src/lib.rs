@@ -12,6 +12,9 @@ mod register;
 pub mod search;
 pub mod verify;
 
+#[cfg(test)]
+mod testmaps;
+
 pub use register::{
     Candidate, KindTotals, Method, PairConfig, RegisterConfig, Registration, Timings, register,
     register_with,

@@ -9,7 +9,7 @@ use grid_core::{Correspondence, CorrespondenceSource, EvidenceKind, OccupancyGri
 use ransac_rigid::{RansacConfig, estimate_rigid};
 use sift_desc::{SiftConfig, SiftCorrespondences};
 
-use crate::global::{GlobalConfig, global_hypotheses};
+use crate::global::{GlobalConfig, SweepConfig, global_hypotheses, sweep_hypotheses};
 use crate::refine::{RefineConfig, refine};
 use crate::search::{SearchConfig, local_search};
 use crate::verify::{PreparedMap, Verification, VerifyConfig, verify};
@@ -29,6 +29,9 @@ pub struct PairConfig {
     /// Global search tried when no feature-based candidate passes verification; `None`
     /// disables it. Default: on, [`GlobalConfig::default`].
     pub global: Option<GlobalConfig>,
+    /// Rotation sweep tried when neither the feature-based nor the global-search candidates
+    /// pass verification; `None` disables it. Default: on, [`SweepConfig::default`].
+    pub sweep: Option<SweepConfig>,
     /// Refinement of global-search candidates: a wider first gate, since they come from a
     /// coarse grid. Default: gate 12 px shrinking to 2 px, at most 24 px of movement.
     pub global_refine: RefineConfig,
@@ -42,6 +45,7 @@ impl Default for PairConfig {
             refine: RefineConfig::default(),
             verify: VerifyConfig::default(),
             global: Some(GlobalConfig::default()),
+            sweep: Some(SweepConfig::default()),
             global_refine: RefineConfig {
                 initial_gate_px: 12.0,
                 max_iterations: 25,
@@ -65,7 +69,7 @@ pub struct Candidate {
     pub verification: Verification,
     /// Whether it passes the verification thresholds.
     pub accepted: bool,
-    /// Where the hypothesis came from: `ransac` or `global`.
+    /// Where the hypothesis came from: `ransac`, `global` (Hough spectrum) or `sweep`.
     pub origin: &'static str,
 }
 
@@ -82,6 +86,8 @@ pub struct Timings {
     pub verify_ms: f64,
     /// Global search, when it ran.
     pub global_ms: f64,
+    /// Rotation sweep, when it ran.
+    pub sweep_ms: f64,
 }
 
 /// The answer for one pair.
@@ -242,24 +248,41 @@ pub fn register_with(
             timings.global_ms = ms(t0);
         }
     }
+    if let Some(sweep) = &config.sweep {
+        if !candidates.iter().any(|c| c.accepted) {
+            let t0 = Instant::now();
+            let mut models = Vec::new();
+            sweep_hypotheses(&pa, &pb, sweep, &mut models);
+            candidates.extend(
+                models
+                    .iter()
+                    .map(|m| check(m, &config.global_refine, "sweep")),
+            );
+            timings.sweep_ms = ms(t0);
+        }
+    }
     candidates.sort_by(|x, y| {
         y.accepted
             .cmp(&x.accepted)
             .then(y.verification.score().total_cmp(&x.verification.score()))
     });
     // Ambiguity: another accepted, clearly different placement that scores almost as well.
-    let centre_b = pb.wall_samples.iter().copied().sum::<grid_core::DVec2>()
-        / pb.wall_samples.len().max(1) as f64;
+    // "Different" is measured where it matters: how far apart the two put B's walls, on average.
+    let probe = crate::verify::strided(&pb.wall_samples, 500);
+    let apart = |x: &Rigid2, y: &Rigid2| {
+        probe
+            .iter()
+            .map(|p| (x.apply(*p) - y.apply(*p)).length())
+            .sum::<f64>()
+            / probe.len().max(1) as f64
+    };
     let rival = candidates.first().filter(|b| b.accepted).and_then(|best| {
         candidates.iter().skip(1).find(|c| {
             c.accepted
                 && (c.verification.score()
                     >= config.verify.max_ambiguity * best.verification.score()
                     || c.verification.wall_lift >= best.verification.wall_lift)
-                && (grid_core::wrap_angle(c.transform.theta - best.transform.theta).abs()
-                    > 3f64.to_radians()
-                    || (c.transform.apply(centre_b) - best.transform.apply(centre_b)).length()
-                        > 5.0)
+                && apart(&c.transform, &best.transform) > config.verify.distinct_px
         })
     });
     if let (Some(best), Some(rival)) = (candidates.first(), rival) {

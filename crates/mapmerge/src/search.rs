@@ -190,22 +190,8 @@ pub fn local_search(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::testmaps::room;
     use crate::verify::VerifyConfig;
-    use grid_core::{OccupancyGrid, Pose2, UNKNOWN};
-
-    /// An L-shaped room with a pillar: walls in both directions pin the pose.
-    fn room() -> OccupancyGrid {
-        let (w, h) = (120, 100);
-        let mut cells = vec![UNKNOWN; w * h];
-        for y in 10..90 {
-            for x in 10..110 {
-                let wall = x == 10 || x == 109 || y == 10 || y == 89 || (x >= 60 && y == 50);
-                let pillar = (30..36).contains(&x) && (30..34).contains(&y);
-                cells[y * w + x] = if wall || pillar { 100 } else { 0 };
-            }
-        }
-        OccupancyGrid::from_cells(w, h, 0.05, Pose2::default(), cells).unwrap()
-    }
 
     #[test]
     fn a_hypothesis_a_few_pixels_off_moves_to_the_truth() {

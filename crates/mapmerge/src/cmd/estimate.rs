@@ -21,10 +21,11 @@ Output (--json): one JSON object on stdout.
                    ready to publish as a TF from A's map frame to B's
   inliers          correspondences within 3 px of the answer; inliers_by_kind splits them
   confidence       wall lift of the answer: 0 is what a random placement scores, 1 is perfect
-                   agreement of the walls; pairs are accepted from 0.65 (and acceptance index
-                   >= 0.8, overlap >= 3 % of the smaller map)
+                   agreement of the walls; pairs are accepted from 0.65 (or 0.8 with walls
+                   compared at 4 px), with acceptance index >= 0.88 and an overlap of at
+                   least 10 % of the smaller map
   verification     wall_agreement, wall_lift, acceptance_index, overlap_cells, overlap_fraction
-  method, hypothesis (ransac or global), correspondences, candidates, timings_ms
+  method, hypothesis (ransac, global or sweep), correspondences, candidates, timings_ms
 
 Exit codes: 0 transform found, 3 no trustworthy match (the pair is declined), 2 bad usage or
 bad input, 1 internal error.
@@ -210,6 +211,7 @@ fn human(w: &mut impl Write, o: &serde_json::Value) -> std::io::Result<()> {
         "prepare_ms",
         "verify_ms",
         "global_ms",
+        "sweep_ms",
     ]
     .iter()
     .map(|k| t[*k].as_f64().unwrap_or(0.0))
