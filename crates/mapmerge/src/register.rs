@@ -29,8 +29,9 @@ pub struct PairConfig {
     /// Global search tried when no feature-based candidate passes verification; `None`
     /// disables it. Default: on, [`GlobalConfig::default`].
     pub global: Option<GlobalConfig>,
-    /// Rotation sweep tried when neither the feature-based nor the global-search candidates
-    /// pass verification; `None` disables it. Default: on, [`SweepConfig::default`].
+    /// Rotation sweep, tried unless a feature-based candidate passed verification with a good
+    /// fit (see [`SweepConfig::confident_wall_lift`]); `None` disables it. Default: on,
+    /// [`SweepConfig::default`].
     pub sweep: Option<SweepConfig>,
     /// Refinement of global-search candidates: a wider first gate, since they come from a
     /// coarse grid. Default: gate 12 px shrinking to 2 px, at most 24 px of movement.
@@ -249,7 +250,16 @@ pub fn register_with(
         }
     }
     if let Some(sweep) = &config.sweep {
-        if !candidates.iter().any(|c| c.accepted) {
+        // Unless a feature-based candidate passed with a good fit. Keypoint matches that agree
+        // and walls that agree are two kinds of evidence; one kind alone (a Hough-spectrum
+        // placement, or a weak fit) can be a wrong placement on repetitive walls, or a poorer
+        // local optimum near the right one. The sweep then proposes the better fit (which
+        // wins) or a rival (and the pair is declined as ambiguous).
+        if !candidates.iter().any(|c| {
+            c.accepted
+                && c.origin == "ransac"
+                && c.verification.wall_lift >= sweep.confident_wall_lift
+        }) {
             let t0 = Instant::now();
             let mut models = Vec::new();
             sweep_hypotheses(&pa, &pb, sweep, &mut models);
