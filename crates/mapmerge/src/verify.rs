@@ -48,9 +48,9 @@ pub struct VerifyConfig {
     /// Minimum overlap, as a fraction of the smaller map's known cells. Default 0.10. Every
     /// wrong placement that passed the other tests in `cargo xtask eval --suites
     /// overlap,zero,paper,real --seed 3` and `--seed 4`, `--suites zero` at seeds 1, 2, 5 and 6,
-    /// and `--suites overlap,zero,paper,real,noise --seed 7` (13 of them, 4 accepted) was a
-    /// sliver of 3.5-9.6 % of the smaller map; no placement within 10 px of the truth in those
-    /// runs overlapped less than 20 %. Lower it to merge maps that share only a corner.
+    /// and `--suites overlap,zero,paper,real,noise --seed 7` (builds bb3528e and before) was
+    /// a sliver of 3.5-9.6 % of the smaller map; no placement within 10 px of the truth in
+    /// those runs overlapped less than 20 %. Lower it to merge maps that share only a corner.
     pub min_overlap_fraction: f64,
     /// A pair is ambiguous, and declined, when a second accepted candidate that differs from
     /// the best (it puts B's walls more than `distinct_px` away from where the best puts
