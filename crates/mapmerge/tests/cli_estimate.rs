@@ -189,28 +189,62 @@ fn bad_input_is_refused_with_exit_2() {
 
 #[test]
 fn debug_png_is_written() {
-    let dir = TempDir::new().unwrap();
-    let png = dir.path().join("m.png");
-    let out = Command::new(env!("CARGO_BIN_EXE_mapmerge"))
-        .args([
-            "estimate",
-            fixture("sunil_pair_a").to_str().unwrap(),
-            fixture("sunil_pair_b").to_str().unwrap(),
-        ])
-        .arg("--debug-png")
-        .arg(&png)
-        .output()
-        .unwrap();
-    assert_eq!(out.status.code(), Some(0));
-    let img = image::open(&png).unwrap();
-    // Three panels: A, B and the overlay in A's frame, 10 px apart.
-    let (a, b) = (380, 500);
-    assert_eq!((img.width(), img.height()), (2 * a + b + 20, 500));
-    assert_eq!(
-        std::fs::read_dir(dir.path()).unwrap().count(),
-        1,
-        "no temporary file left"
-    );
+    // Both orders: the panels must not depend on which map is wider (A is 380 px wide, B 500).
+    for (first, second) in [
+        ("sunil_pair_a", "sunil_pair_b"),
+        ("sunil_pair_b", "sunil_pair_a"),
+    ] {
+        let dir = TempDir::new().unwrap();
+        let png = dir.path().join("m.png");
+        let out = Command::new(env!("CARGO_BIN_EXE_mapmerge"))
+            .args([
+                "estimate",
+                fixture(first).to_str().unwrap(),
+                fixture(second).to_str().unwrap(),
+            ])
+            .arg("--debug-png")
+            .arg(&png)
+            .output()
+            .unwrap();
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{first} {second}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let img = image::open(&png).unwrap().to_rgb8();
+        let a = load_map(fixture(first), &LoadOptions::default()).unwrap();
+        let b = load_map(fixture(second), &LoadOptions::default()).unwrap();
+        // Three panels: A, B and the overlay in A's frame, 10 px apart.
+        let (wa, wb) = (a.width() as u32, b.width() as u32);
+        assert_eq!(
+            (img.width(), img.height()),
+            (2 * wa + wb + 20, a.height().max(b.height()) as u32)
+        );
+        // B's panel is whole: its known cells show as free (white) or occupied (black) where
+        // the panel puts them, except under the match lines drawn across it (3-4 % here).
+        let (mut shown, mut known) = (0, 0);
+        for y in 0..b.height() {
+            for x in 0..b.width() {
+                let want = match b.state(x, y) {
+                    CellState::Free => [255, 255, 255],
+                    CellState::Occupied => [0, 0, 0],
+                    CellState::Unknown => continue,
+                };
+                known += 1;
+                shown += usize::from(img.get_pixel(wa + 10 + x as u32, y as u32).0 == want);
+            }
+        }
+        assert!(
+            shown as f64 > 0.95 * known as f64,
+            "{first} {second}: B's panel shows {shown} of {known} known cells"
+        );
+        assert_eq!(
+            std::fs::read_dir(dir.path()).unwrap().count(),
+            1,
+            "no temporary file left"
+        );
+    }
 }
 
 #[test]

@@ -287,8 +287,8 @@ fn write_debug_png(
         let colour = if inlier { [0, 170, 0] } else { [220, 40, 40] };
         line(&mut img, c.a, c.b + DVec2::new(bx as f64, 0.0), colour);
     }
-    // Overlay in A's frame.
-    let ox = 2 * wa + 2 * GAP;
+    // Overlay in A's frame, right of B's panel.
+    let ox = bx + wb + GAP;
     if let Some(t) = t {
         let inv = t.inverse();
         for y in 0..ha {
