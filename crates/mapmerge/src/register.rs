@@ -236,40 +236,40 @@ pub fn register_with(
         })
         .collect();
     timings.verify_ms = ms(t0);
-    if let Some(global) = &config.global {
-        if !candidates.iter().any(|c| c.accepted) {
-            let t0 = Instant::now();
-            let mut models = Vec::new();
-            global_hypotheses(&pa, &pb, global, &mut models);
-            candidates.extend(
-                models
-                    .iter()
-                    .map(|m| check(m, &config.global_refine, "global")),
-            );
-            timings.global_ms = ms(t0);
-        }
+    // The whole-map searches: their placements are checked like the feature-based ones, with
+    // the global refinement (they come from a coarse grid).
+    let search = |generate: &dyn Fn(&mut Vec<Rigid2>), origin| {
+        let t0 = Instant::now();
+        let mut models = Vec::new();
+        generate(&mut models);
+        let found: Vec<Candidate> = models
+            .iter()
+            .map(|m| check(m, &config.global_refine, origin))
+            .collect();
+        (found, ms(t0))
+    };
+    if let Some(global) = &config.global
+        && !candidates.iter().any(|c| c.accepted)
+    {
+        let (found, t) = search(&|out| global_hypotheses(&pa, &pb, global, out), "global");
+        candidates.extend(found);
+        timings.global_ms = t;
     }
-    if let Some(sweep) = &config.sweep {
-        // Unless a feature-based candidate passed with a good fit. Keypoint matches that agree
-        // and walls that agree are two kinds of evidence; one kind alone (a Hough-spectrum
-        // placement, or a weak fit) can be a wrong placement on repetitive walls, or a poorer
-        // local optimum near the right one. The sweep then proposes the better fit (which
-        // wins) or a rival (and the pair is declined as ambiguous).
-        if !candidates.iter().any(|c| {
+    // The sweep runs unless a feature-based candidate passed with a good fit. Keypoint matches
+    // that agree and walls that agree are two kinds of evidence; one kind alone (a
+    // Hough-spectrum placement, or a weak fit) can be a wrong placement on repetitive walls, or
+    // a poorer local optimum near the right one. The sweep then proposes the better fit (which
+    // wins) or a rival (and the pair is declined as ambiguous).
+    if let Some(sweep) = &config.sweep
+        && !candidates.iter().any(|c| {
             c.accepted
                 && c.origin == "ransac"
                 && c.verification.wall_lift >= sweep.confident_wall_lift
-        }) {
-            let t0 = Instant::now();
-            let mut models = Vec::new();
-            sweep_hypotheses(&pa, &pb, sweep, &mut models);
-            candidates.extend(
-                models
-                    .iter()
-                    .map(|m| check(m, &config.global_refine, "sweep")),
-            );
-            timings.sweep_ms = ms(t0);
-        }
+        })
+    {
+        let (found, t) = search(&|out| sweep_hypotheses(&pa, &pb, sweep, out), "sweep");
+        candidates.extend(found);
+        timings.sweep_ms = t;
     }
     candidates.sort_by(|x, y| {
         y.accepted
