@@ -44,6 +44,9 @@ pub struct EvalArgs {
     /// Skip the correlative local search before ICP (to measure what it adds).
     #[arg(long)]
     no_search: bool,
+    /// Skip the symmetry probes of the best candidate (to measure what they add).
+    #[arg(long)]
+    no_symmetry: bool,
     /// Override the verification's wall tolerance in pixels (default: the library's), for
     /// calibration experiments.
     #[arg(long)]
@@ -56,6 +59,14 @@ pub struct EvalArgs {
     /// library's), for calibration experiments.
     #[arg(long)]
     top_k: Option<usize>,
+    /// Override how many placements the rotation sweep keeps (default: the library's), for
+    /// calibration experiments.
+    #[arg(long)]
+    sweep_keep: Option<usize>,
+    /// Override the rotation sweep's coarse image size (default: the library's), for
+    /// calibration experiments.
+    #[arg(long)]
+    sweep_size: Option<usize>,
     /// Only the rows whose label contains this text (e.g. `"overlap 0.3"`).
     #[arg(long)]
     only: Option<String>,
@@ -238,6 +249,9 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
     if let Some(t) = args.wall_tolerance {
         config.pair.verify.wall_tolerance_px = t;
     }
+    if args.no_symmetry {
+        config.pair.symmetry_probes = false;
+    }
     if args.no_search {
         config.pair.search = None;
     }
@@ -246,6 +260,14 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
     }
     if let Some(k) = args.top_k {
         config.pair.ransac.top_k = k;
+    }
+    if let Some(sweep) = config.pair.sweep.as_mut() {
+        if let Some(k) = args.sweep_keep {
+            sweep.keep = k;
+        }
+        if let Some(n) = args.sweep_size {
+            sweep.coarse_size = n;
+        }
     }
     config
 }

@@ -316,6 +316,42 @@ pub fn global_hypotheses(
     }
 }
 
+/// Append the twins of placement `b_to_a` to `out`: for its angle, and its angle plus a
+/// quarter, a half and three quarters of a turn, the best `config.translation_peaks`
+/// translations of B's walls on A's coarse wall field (as in [`global_hypotheses`]). Maps that look alike
+/// turned (a bare room, a symmetric corridor) fit a twin about as well as the placement
+/// itself; [`crate::register_with`] refines and verifies the twins so that such a pair is
+/// declined as ambiguous rather than answered by a coin toss.
+pub fn twins(
+    a: &PreparedMap,
+    b: &PreparedMap,
+    b_to_a: &Rigid2,
+    config: &GlobalConfig,
+    out: &mut Vec<Rigid2>,
+) {
+    use rayon::prelude::*;
+    let pb = strided(&b.wall_samples, config.max_points);
+    if pb.len() < 10 || a.wall_samples.len() < 10 {
+        return;
+    }
+    let field = CoarseField::new(a, b, config.coarse_size, &mut FftPlanner::new());
+    // The first turn is none: the other translation peaks of the placement's own angle are
+    // its shifted twins (a row of alike rooms).
+    let found: Vec<Rigid2> = [0.0, 0.5, 1.0, 1.5]
+        .par_iter()
+        .map_init(
+            || (FftPlanner::<f32>::new(), Vec::new()),
+            |(planner, buf), &k| {
+                let theta = b_to_a.theta + k * PI;
+                field.correlate(&pb, theta, config.translation_peaks, planner, buf)
+            },
+        )
+        .flatten_iter()
+        .map(|(_, t)| t)
+        .collect();
+    out.extend(found);
+}
+
 /// Parameters of the rotation sweep, with documented defaults.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SweepConfig {
@@ -459,6 +495,39 @@ mod tests {
             let first = grid_core::metrics::displacement_error(&b, &found[0], &truth).unwrap();
             assert!(first < 6.0, "{deg} deg: first placement {first} px off");
         }
+    }
+
+    #[test]
+    fn the_twins_of_a_bare_room_include_its_half_turn() {
+        let a = crate::testmaps::bare_room();
+        let vc = VerifyConfig::default();
+        let pa = PreparedMap::new(&a, &vc);
+        let a_to_b = Rigid2::new(37f64.to_radians(), 60.0, 20.0);
+        let b = a.warp(&a_to_b, 200, 190).unwrap();
+        let (truth, pb) = (a_to_b.inverse(), PreparedMap::new(&b, &vc));
+        // The room's half turn about its centre (59.5, 49.5) maps it onto itself.
+        let c = DVec2::new(59.5, 49.5);
+        let half = Rigid2::new(PI, 2.0 * c.x, 2.0 * c.y);
+        let twin = half.compose(&truth);
+        let mut out = Vec::new();
+        twins(&pa, &pb, &truth, &GlobalConfig::default(), &mut out);
+        assert_eq!(out.len(), 4 * GlobalConfig::default().translation_peaks);
+        let nearest = |target: &Rigid2| {
+            out.iter()
+                .map(|t| grid_core::metrics::displacement_error(&b, t, target).unwrap())
+                .fold(f64::INFINITY, f64::min)
+        };
+        // Within a coarse cell (about 1.5 px for these maps) and the rounding of the walls.
+        assert!(
+            nearest(&twin) < 4.0,
+            "half-turn twin {} px off",
+            nearest(&twin)
+        );
+        assert!(
+            nearest(&truth) < 4.0,
+            "unturned twin {} px off",
+            nearest(&truth)
+        );
     }
 
     #[test]

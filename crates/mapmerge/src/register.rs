@@ -9,7 +9,7 @@ use grid_core::{Correspondence, CorrespondenceSource, EvidenceKind, OccupancyGri
 use ransac_rigid::{RansacConfig, estimate_rigid};
 use sift_desc::{SiftConfig, SiftCorrespondences};
 
-use crate::global::{GlobalConfig, SweepConfig, global_hypotheses, sweep_hypotheses};
+use crate::global::{GlobalConfig, SweepConfig, global_hypotheses, sweep_hypotheses, twins};
 use crate::refine::{RefineConfig, refine};
 use crate::search::{SearchConfig, local_search};
 use crate::verify::{PreparedMap, Verification, VerifyConfig, verify};
@@ -36,6 +36,18 @@ pub struct PairConfig {
     /// Refinement of global-search candidates: a wider first gate, since they come from a
     /// coarse grid. Default: gate 12 px shrinking to 2 px, at most 24 px of movement.
     pub global_refine: RefineConfig,
+    /// Symmetry probes of the best accepted candidate: at its angle, and its angle turned by a
+    /// quarter, a half and three quarters of a turn, the best translations are found by
+    /// correlation ([`crate::global::twins`], with the `global` settings or their
+    /// defaults), and each twin is refined and verified like a global-search candidate. A
+    /// row of alike rooms, or a room or rubble field that looks the same turned, fits a twin
+    /// about as well, and a twin that passes verification on its own makes the pair
+    /// ambiguous (unless it contradicts the maps more, see
+    /// [`VerifyConfig::max_contradiction_excess`]): it is declined instead of answered by a
+    /// coin toss. Like the sweep, the probes are skipped when the best is a feature-based
+    /// candidate with a good fit ([`SweepConfig::confident_wall_lift`]): keypoints that agree
+    /// do not repeat with the walls. Default on.
+    pub symmetry_probes: bool,
 }
 
 impl Default for PairConfig {
@@ -53,6 +65,7 @@ impl Default for PairConfig {
                 max_shift_px: 24.0,
                 ..RefineConfig::default()
             },
+            symmetry_probes: true,
         }
     }
 }
@@ -89,6 +102,8 @@ pub struct Timings {
     pub global_ms: f64,
     /// Rotation sweep, when it ran.
     pub sweep_ms: f64,
+    /// Symmetry probes of the best accepted candidate, when they ran.
+    pub symmetry_ms: f64,
 }
 
 /// The answer for one pair.
@@ -260,22 +275,51 @@ pub fn register_with(
     // Hough-spectrum placement, or a weak fit) can be a wrong placement on repetitive walls, or
     // a poorer local optimum near the right one. The sweep then proposes the better fit (which
     // wins) or a rival (and the pair is declined as ambiguous).
+    // A feature-based candidate that passed with a good fit: keypoint matches that agree and
+    // walls that agree, two kinds of evidence.
+    let confident_wall_lift = config
+        .sweep
+        .map_or(SweepConfig::default().confident_wall_lift, |s| {
+            s.confident_wall_lift
+        });
+    let confident = |c: &Candidate| {
+        c.accepted && c.origin == "ransac" && c.verification.wall_lift >= confident_wall_lift
+    };
     if let Some(sweep) = &config.sweep
-        && !candidates.iter().any(|c| {
-            c.accepted
-                && c.origin == "ransac"
-                && c.verification.wall_lift >= sweep.confident_wall_lift
-        })
+        && !candidates.iter().any(confident)
     {
         let (found, t) = search(&|out| sweep_hypotheses(&pa, &pb, sweep, out), "sweep");
         candidates.extend(found);
         timings.sweep_ms = t;
     }
-    candidates.sort_by(|x, y| {
-        y.accepted
-            .cmp(&x.accepted)
-            .then(y.verification.score().total_cmp(&x.verification.score()))
-    });
+    let rank = |candidates: &mut Vec<Candidate>| {
+        candidates.sort_by(|x, y| {
+            y.accepted
+                .cmp(&x.accepted)
+                .then(y.verification.score().total_cmp(&x.verification.score()))
+        })
+    };
+    rank(&mut candidates);
+    if config.symmetry_probes
+        && let Some(best) = candidates.first().filter(|c| c.accepted && !confident(c))
+    {
+        let t0 = Instant::now();
+        let mut probes = Vec::new();
+        twins(
+            &pa,
+            &pb,
+            &best.transform,
+            &config.global.unwrap_or_default(),
+            &mut probes,
+        );
+        let found: Vec<Candidate> = probes
+            .par_iter()
+            .map(|m| check(m, &config.global_refine, "symmetry"))
+            .collect();
+        candidates.extend(found);
+        rank(&mut candidates);
+        timings.symmetry_ms = ms(t0);
+    }
     // Ambiguity: another accepted, clearly different placement that scores almost as well.
     // "Different" is measured where it matters: how far apart the two put B's walls, on average.
     let probe = crate::verify::strided(&pb.wall_samples, 500);
@@ -288,10 +332,15 @@ pub fn register_with(
     };
     let rival = candidates.first().filter(|b| b.accepted).and_then(|best| {
         candidates.iter().skip(1).find(|c| {
+            // A twin that passes on its own is a rival whatever its score: its overlap, and so
+            // its support, differs from the best's by construction.
             c.accepted
                 && (c.verification.score()
                     >= config.verify.max_ambiguity * best.verification.score()
-                    || c.verification.wall_lift >= best.verification.wall_lift)
+                    || c.verification.wall_lift >= best.verification.wall_lift
+                    || c.origin == "symmetry")
+                && c.verification.wall_contradiction
+                    <= best.verification.wall_contradiction + config.verify.max_contradiction_excess
                 && apart(&c.transform, &best.transform) > config.verify.distinct_px
         })
     });
@@ -414,4 +463,59 @@ pub fn register(
         Method::Hybrid => vec![&sift, &blobs],
     };
     Ok(register_with(a, b, &sources, &config.pair))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::testmaps::{bare_room, room};
+    use grid_core::metrics::displacement_error;
+
+    /// B is `a` turned by 37 degrees and shifted onto a larger canvas; returns B and the truth.
+    fn turned(a: &OccupancyGrid) -> (OccupancyGrid, Rigid2) {
+        let a_to_b = Rigid2::new(37f64.to_radians(), 60.0, 20.0);
+        (a.warp(&a_to_b, 200, 190).unwrap(), a_to_b.inverse())
+    }
+
+    fn pair_config(symmetry_probes: bool) -> RegisterConfig {
+        RegisterConfig {
+            pair: PairConfig {
+                symmetry_probes,
+                ..PairConfig::default()
+            },
+            ..RegisterConfig::default()
+        }
+    }
+
+    #[test]
+    fn a_room_that_looks_the_same_turned_is_declined_as_ambiguous() {
+        let a = bare_room();
+        let (b, _) = turned(&a);
+        let r = register(&a, &b, &pair_config(true)).unwrap();
+        assert!(r.accepted.is_none(), "accepted {:?}", r.accepted);
+        let reason = r.reason.unwrap();
+        assert!(reason.starts_with("ambiguous"), "{reason}");
+        // The rival is a twin that passed on its own.
+        assert!(
+            r.candidates
+                .iter()
+                .any(|c| c.accepted && c.origin == "symmetry"),
+            "{:?}",
+            r.candidates
+        );
+    }
+
+    #[test]
+    fn the_symmetry_probes_keep_an_asymmetric_room() {
+        let a = room();
+        let (b, truth) = turned(&a);
+        for probes in [false, true] {
+            let r = register(&a, &b, &pair_config(probes)).unwrap();
+            let best = r
+                .accepted
+                .unwrap_or_else(|| panic!("declined: {:?}", r.reason));
+            let err = displacement_error(&b, &best.transform, &truth).unwrap();
+            assert!(err < 1.0, "probes {probes}: {err} px off");
+        }
+    }
 }

@@ -16,3 +16,17 @@ pub(crate) fn room() -> OccupancyGrid {
     }
     OccupancyGrid::from_cells(w, h, 0.05, Pose2::default(), cells).unwrap()
 }
+
+/// A bare rectangular room (90 x 60 inside) on a 120 x 100 canvas: a half turn about its centre
+/// maps it onto itself, so no pose between it and a turned copy can be told from its twin.
+pub(crate) fn bare_room() -> OccupancyGrid {
+    let (w, h) = (120, 100);
+    let mut cells = vec![UNKNOWN; w * h];
+    for y in 20..80 {
+        for x in 15..105 {
+            let wall = x == 15 || x == 104 || y == 20 || y == 79;
+            cells[y * w + x] = if wall { 100 } else { 0 };
+        }
+    }
+    OccupancyGrid::from_cells(w, h, 0.05, Pose2::default(), cells).unwrap()
+}

@@ -67,6 +67,11 @@ pub struct VerifyConfig {
     /// overlap,zero,paper,real,noise --seed 7` the two pairs that rule declined as ambiguous
     /// had their rival about 7 px (mean over B's cells) from the best.
     pub distinct_px: f64,
+    /// A placement is a rival of the best (see `max_ambiguity`) only if its
+    /// [`Verification::wall_contradiction`] exceeds the best's by at most this. Default 0.05:
+    /// a twin of a room with a little inner structure (a half wall, a pillar) fits the outer
+    /// walls as well as the truth, but puts the inner structure in free space.
+    pub max_contradiction_excess: f64,
 }
 
 impl Default for VerifyConfig {
@@ -82,6 +87,7 @@ impl Default for VerifyConfig {
             min_overlap_fraction: 0.10,
             max_ambiguity: 0.6,
             distinct_px: 10.0,
+            max_contradiction_excess: 0.05,
         }
     }
 }
@@ -237,6 +243,11 @@ pub struct Verification {
     pub wall_lift: f64,
     /// Wall cells compared, both directions together.
     pub wall_support: usize,
+    /// Share of compared wall cells that land on a free cell of the other map farther than
+    /// the wide tolerance from any of its walls: an obstacle where the other robot saw
+    /// through. Used to tell a true rival placement from a twin that leaves part of the
+    /// structure in the other map's free space (see [`VerifyConfig::max_contradiction_excess`]).
+    pub wall_contradiction: f64,
     /// The lift at the wide tolerance ([`VerifyConfig::wide_tolerance_px`]).
     pub wide_wall_lift: f64,
     /// Acceptance index over sampled cells known in both maps.
@@ -271,19 +282,21 @@ fn cell_of(grid: &OccupancyGrid, q: DVec2) -> Option<(usize, usize)> {
         .then_some((x as usize, y as usize))
 }
 
-/// Wall hits (within `tol` and within `wide`) and wall cells compared when `from`'s walls are
-/// mapped onto `onto` by `t`.
+/// Wall hits (within `tol` and within `wide`), contradictions (landing on a free cell
+/// farther than `wide` from any wall) and wall cells compared when `from`'s walls are mapped
+/// onto `onto` by `t`.
 fn wall_hits(
     from: &PreparedMap,
     onto: &PreparedMap,
     t: &Rigid2,
     tol: f32,
     wide: f32,
-) -> (usize, usize, usize) {
-    let (mut hits, mut wide_hits, mut total) = (0, 0, 0);
+) -> (usize, usize, usize, usize) {
+    let (mut hits, mut wide_hits, mut contra, mut total) = (0, 0, 0, 0);
     for &p in &from.wall_samples {
         if let Some((x, y)) = cell_of(onto.grid, t.apply(p)) {
-            if onto.grid.state(x, y) == CellState::Unknown {
+            let state = onto.grid.state(x, y);
+            if state == CellState::Unknown {
                 continue;
             }
             total += 1;
@@ -293,10 +306,12 @@ fn wall_hits(
             }
             if d <= wide {
                 wide_hits += 1;
+            } else if state == CellState::Free {
+                contra += 1;
             }
         }
     }
-    (hits, wide_hits, total)
+    (hits, wide_hits, contra, total)
 }
 
 /// `(agreement - base) / (1 - base)`, with the base weighted like the observed agreement.
@@ -321,14 +336,17 @@ pub fn verify(
     config: &VerifyConfig,
 ) -> Verification {
     let (tol, wide) = (config.wall_tolerance_px, config.wide_tolerance_px);
-    let (h_ba, w_ba, n_ba) = wall_hits(b, a, b_to_a, tol, wide);
-    let (h_ab, w_ab, n_ab) = wall_hits(a, b, &b_to_a.inverse(), tol, wide);
+    let (h_ba, w_ba, c_ba, n_ba) = wall_hits(b, a, b_to_a, tol, wide);
+    let (h_ab, w_ab, c_ab, n_ab) = wall_hits(a, b, &b_to_a.inverse(), tol, wide);
     let wall_support = n_ba + n_ab;
-    let wall_agreement = if wall_support == 0 {
-        0.0
-    } else {
-        (h_ba + h_ab) as f64 / wall_support as f64
+    let share = |n: usize| {
+        if wall_support == 0 {
+            0.0
+        } else {
+            n as f64 / wall_support as f64
+        }
     };
+    let (wall_agreement, wall_contradiction) = (share(h_ba + h_ab), share(c_ba + c_ab));
     // Expected agreement of a random placement, weighted like the observed one.
     let wall_lift = lift(
         h_ba + h_ab,
@@ -373,6 +391,7 @@ pub fn verify(
         wall_agreement,
         wall_lift,
         wall_support,
+        wall_contradiction,
         wide_wall_lift,
         acceptance_index,
         overlap_cells,
