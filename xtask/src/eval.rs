@@ -67,6 +67,9 @@ pub struct EvalArgs {
     /// calibration experiments.
     #[arg(long)]
     sweep_size: Option<usize>,
+    /// Range-bias prior weight (experiment; `0` or less turns the model off).
+    #[arg(long)]
+    range_bias: Option<f64>,
     /// Only the rows whose label contains this text (e.g. `"overlap 0.3"`).
     #[arg(long)]
     only: Option<String>,
@@ -260,6 +263,11 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
     }
     if let Some(k) = args.top_k {
         config.pair.ransac.top_k = k;
+    }
+    if let Some(w) = args.range_bias {
+        let prior = (w > 0.0).then_some(w);
+        config.pair.refine.range_bias = prior;
+        config.pair.global_refine.range_bias = prior;
     }
     if let Some(sweep) = config.pair.sweep.as_mut() {
         if let Some(k) = args.sweep_keep {

@@ -5,11 +5,19 @@ use grid_core::{OccupancyGrid, Pose2, UNKNOWN};
 /// An L-shaped room with a pillar on a 120 x 100 canvas: walls in both directions pin the pose,
 /// and no turn of it but the identity fits it.
 pub(crate) fn room() -> OccupancyGrid {
+    grown_room(0)
+}
+
+/// [`room`] with its outer walls moved `d` cells outwards (at most 2), as a range sensor's bias
+/// pushes walls seen from inside the room; the half wall and the pillar stay.
+pub(crate) fn grown_room(d: usize) -> OccupancyGrid {
+    assert!(d <= 2);
     let (w, h) = (120, 100);
+    let (x0, x1, y0, y1) = (10 - d, 109 + d, 10 - d, 89 + d);
     let mut cells = vec![UNKNOWN; w * h];
-    for y in 10..90 {
-        for x in 10..110 {
-            let wall = x == 10 || x == 109 || y == 10 || y == 89 || (x >= 60 && y == 50);
+    for y in y0..=y1 {
+        for x in x0..=x1 {
+            let wall = x == x0 || x == x1 || y == y0 || y == y1 || (x >= 60 && y == 50);
             let pillar = (30..36).contains(&x) && (30..34).contains(&y);
             cells[y * w + x] = if wall || pillar { 100 } else { 0 };
         }

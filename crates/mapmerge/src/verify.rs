@@ -113,6 +113,9 @@ pub struct PreparedMap<'a> {
     /// `[0, pi)`) of the wall normal at an occupied cell, NaN where the cell is not occupied or
     /// the local wall has no clear direction.
     pub normals: Vec<f32>,
+    /// Per cell of the known window, the side of the wall normal on which free space lies
+    /// (see [`PreparedMap::free_side`]).
+    pub free_sides: Vec<i8>,
 }
 
 /// At most `max` of `points`, evenly strided (deterministic).
@@ -156,6 +159,7 @@ impl<'a> PreparedMap<'a> {
         }
         let known_cells = known.len();
         let normals = wall_normals(grid, (x0, y0, ww, wh));
+        let free_sides = free_sides(grid, (x0, y0, ww, wh), &normals);
         let rate = |n: usize| {
             if known_cells == 0 {
                 0.0
@@ -173,6 +177,7 @@ impl<'a> PreparedMap<'a> {
             wall_base_rate,
             wide_base_rate,
             normals,
+            free_sides,
         }
     }
 
@@ -182,7 +187,66 @@ impl<'a> PreparedMap<'a> {
         let a = self.normals[self.walls.index(x, y)?];
         (!a.is_nan()).then(|| DVec2::from_angle(a as f64))
     }
+
+    /// Unit normal of the wall at occupied cell `(x, y)`, if it has a clear direction, and the
+    /// side of it on which free space lies (`1`, `-1`, or `0`; see [`PreparedMap::free_side`]).
+    #[inline]
+    pub fn normal_and_side(&self, x: usize, y: usize) -> Option<(DVec2, f64)> {
+        let i = self.walls.index(x, y)?;
+        let a = self.normals[i];
+        (!a.is_nan()).then(|| (DVec2::from_angle(a as f64), self.free_sides[i] as f64))
+    }
+
+    /// Unit normal of the wall at occupied cell `(x, y)` pointing to its free side: zero when
+    /// the wall has no clear direction, or free space on both sides or on neither (within
+    /// [`FREE_SIDE_REACH`] cells).
+    #[inline]
+    pub fn free_side(&self, x: usize, y: usize) -> DVec2 {
+        let Some(i) = self.walls.index(x, y) else {
+            return DVec2::ZERO;
+        };
+        let (a, side) = (self.normals[i], self.free_sides[i]);
+        if a.is_nan() || side == 0 {
+            return DVec2::ZERO;
+        }
+        DVec2::from_angle(a as f64) * side as f64
+    }
 }
+
+/// Per cell of `window`, on which side of its wall normal (`normals`) free space lies: `1`
+/// along the normal, `-1` against it, `0` on both, neither, or where there is no normal.
+fn free_sides(
+    grid: &OccupancyGrid,
+    window: (usize, usize, usize, usize),
+    normals: &[f32],
+) -> Vec<i8> {
+    let (x0, y0, ww, _) = window;
+    let free_towards = |p: DVec2, dir: DVec2| {
+        (1..=FREE_SIDE_REACH).any(|t| {
+            cell_of(grid, p + dir * t as f64)
+                .is_some_and(|(qx, qy)| grid.state(qx, qy) == CellState::Free)
+        })
+    };
+    normals
+        .iter()
+        .enumerate()
+        .map(|(i, &a)| {
+            if a.is_nan() {
+                return 0;
+            }
+            let p = DVec2::new((x0 + i % ww) as f64, (y0 + i / ww) as f64);
+            let n = DVec2::from_angle(a as f64);
+            match (free_towards(p, n), free_towards(p, -n)) {
+                (true, false) => 1,
+                (false, true) => -1,
+                _ => 0,
+            }
+        })
+        .collect()
+}
+
+/// How far (cells) [`PreparedMap::free_side`] looks for free space across a wall band.
+pub const FREE_SIDE_REACH: usize = 3;
 
 /// Wall normals from the second moments of the occupied cells in a 5 x 5 window: the wall runs
 /// along the principal axis, the normal across it. Blobs without a dominant axis get NaN.

@@ -24,8 +24,9 @@ Output (--json): one JSON object on stdout.
                    agreement of the walls; pairs are accepted from 0.65 (or 0.8 with walls
                    compared at 4 px), with acceptance index >= 0.88 and an overlap of at
                    least 10 % of the smaller map
-  verification     wall_agreement, wall_lift, acceptance_index, overlap_cells, overlap_fraction
-  method, hypothesis (ransac, global or sweep), correspondences, candidates, timings_ms
+  verification     wall_agreement, wall_lift, wall_contradiction (share of walls landing in the
+                   other map's free space), acceptance_index, overlap_cells, overlap_fraction
+  method, hypothesis (ransac, global, sweep or symmetry), correspondences, candidates, timings_ms
 
 Exit codes: 0 transform found, 3 no trustworthy match (the pair is declined), 2 bad usage or
 bad input, 1 internal error.
@@ -212,6 +213,7 @@ fn human(w: &mut impl Write, o: &serde_json::Value) -> std::io::Result<()> {
         "verify_ms",
         "global_ms",
         "sweep_ms",
+        "symmetry_ms",
     ]
     .iter()
     .map(|k| t[*k].as_f64().unwrap_or(0.0))
