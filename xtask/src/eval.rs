@@ -67,7 +67,8 @@ pub struct EvalArgs {
     /// calibration experiments.
     #[arg(long)]
     sweep_size: Option<usize>,
-    /// Range-bias prior weight (experiment; `0` or less turns the model off).
+    /// Override the refinement's range-bias prior weight (`0` or less turns the model off;
+    /// default: the library's), to measure what it adds.
     #[arg(long)]
     range_bias: Option<f64>,
     /// Only the rows whose label contains this text (e.g. `"overlap 0.3"`).
