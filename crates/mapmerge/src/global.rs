@@ -318,10 +318,11 @@ pub fn global_hypotheses(
 
 /// Append the twins of placement `b_to_a` to `out`: for its angle, and its angle plus a
 /// quarter, a half and three quarters of a turn, the best `config.translation_peaks`
-/// translations of B's walls on A's coarse wall field (as in [`global_hypotheses`]). Maps that look alike
-/// turned (a bare room, a symmetric corridor) fit a twin about as well as the placement
-/// itself; [`crate::register_with`] refines and verifies the twins so that such a pair is
-/// declined as ambiguous rather than answered by a coin toss.
+/// translations of B's walls on A's coarse wall field (as in [`global_hypotheses`]), in that
+/// order (deterministic). Maps that look alike shifted or turned (a row of rooms, a bare
+/// room) fit a twin about as well as the placement itself; [`crate::register_with`] refines
+/// and verifies the twins so that such a pair is declined as ambiguous rather than answered
+/// by a coin toss.
 pub fn twins(
     a: &PreparedMap,
     b: &PreparedMap,

@@ -270,13 +270,8 @@ pub fn register_with(
         candidates.extend(found);
         timings.global_ms = t;
     }
-    // The sweep runs unless a feature-based candidate passed with a good fit. Keypoint matches
-    // that agree and walls that agree are two kinds of evidence; one kind alone (a
-    // Hough-spectrum placement, or a weak fit) can be a wrong placement on repetitive walls, or
-    // a poorer local optimum near the right one. The sweep then proposes the better fit (which
-    // wins) or a rival (and the pair is declined as ambiguous).
-    // A feature-based candidate that passed with a good fit: keypoint matches that agree and
-    // walls that agree, two kinds of evidence.
+    // A feature-based candidate that passed with a good fit (see below). Without a sweep
+    // configured, its default bar still decides whether the symmetry probes run.
     let confident_wall_lift = config
         .sweep
         .map_or(SweepConfig::default().confident_wall_lift, |s| {
@@ -285,6 +280,11 @@ pub fn register_with(
     let confident = |c: &Candidate| {
         c.accepted && c.origin == "ransac" && c.verification.wall_lift >= confident_wall_lift
     };
+    // The sweep runs unless a feature-based candidate passed with a good fit. Keypoint matches
+    // that agree and walls that agree are two kinds of evidence; one kind alone (a
+    // Hough-spectrum placement, or a weak fit) can be a wrong placement on repetitive walls, or
+    // a poorer local optimum near the right one. The sweep then proposes the better fit (which
+    // wins) or a rival (and the pair is declined as ambiguous).
     if let Some(sweep) = &config.sweep
         && !candidates.iter().any(confident)
     {
@@ -332,8 +332,9 @@ pub fn register_with(
     };
     let rival = candidates.first().filter(|b| b.accepted).and_then(|best| {
         candidates.iter().skip(1).find(|c| {
-            // A twin that passes on its own is a rival whatever its score: its overlap, and so
-            // its support, differs from the best's by construction.
+            // A twin that passes on its own is a rival whatever its score (its overlap, and so
+            // its support, differs from the best's by construction), unless it puts clearly
+            // more walls into the other map's free space.
             c.accepted
                 && (c.verification.score()
                     >= config.verify.max_ambiguity * best.verification.score()
