@@ -47,6 +47,9 @@ pub struct EvalArgs {
     /// Skip the symmetry probes of the best candidate (to measure what they add).
     #[arg(long)]
     no_symmetry: bool,
+    /// Score candidates without their range-bias offsets (to measure what they add).
+    #[arg(long)]
+    no_offset_scoring: bool,
     /// Override the verification's wall tolerance in pixels (default: the library's), for
     /// calibration experiments.
     #[arg(long)]
@@ -252,6 +255,9 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
     let mut config = RegisterConfig::default();
     if let Some(t) = args.wall_tolerance {
         config.pair.verify.wall_tolerance_px = t;
+    }
+    if args.no_offset_scoring {
+        config.pair.offsets_in_verification = false;
     }
     if args.no_symmetry {
         config.pair.symmetry_probes = false;

@@ -10,9 +10,9 @@ use ransac_rigid::{RansacConfig, estimate_rigid};
 use sift_desc::{SiftConfig, SiftCorrespondences};
 
 use crate::global::{GlobalConfig, SweepConfig, global_hypotheses, sweep_hypotheses, twins};
-use crate::refine::{RefineConfig, refine};
+use crate::refine::{RefineConfig, refine_with_bias};
 use crate::search::{SearchConfig, local_search};
-use crate::verify::{PreparedMap, Verification, VerifyConfig, verify};
+use crate::verify::{PreparedMap, Verification, VerifyConfig, verify, verify_with_offsets};
 
 /// Everything that tunes [`register_with`], with documented defaults.
 #[derive(Debug, Clone)]
@@ -48,6 +48,9 @@ pub struct PairConfig {
     /// candidate with a good fit ([`SweepConfig::confident_wall_lift`]): keypoints that agree
     /// do not repeat with the walls. Default on.
     pub symmetry_probes: bool,
+    /// Score each candidate with the range-bias offsets its refinement fitted applied to the
+    /// walls (see [`crate::verify::verify_with_offsets`]).
+    pub offsets_in_verification: bool,
 }
 
 impl Default for PairConfig {
@@ -66,6 +69,7 @@ impl Default for PairConfig {
                 ..RefineConfig::default()
             },
             symmetry_probes: true,
+            offsets_in_verification: true,
         }
     }
 }
@@ -216,8 +220,14 @@ pub fn register_with(
     // with more wins. Global hypotheses refine with their own, wider-gated configuration.
     let check = |model: &Rigid2, refine_config: &RefineConfig, origin| {
         let polish = |start: &Rigid2| {
-            let transform = refine(&pa, &pb, start, refine_config).normalized();
-            (transform, verify(&pa, &pb, &transform, &config.verify))
+            let (transform, offsets) = refine_with_bias(&pa, &pb, start, refine_config);
+            let transform = transform.normalized();
+            let v = if config.offsets_in_verification {
+                verify_with_offsets(&pa, &pb, &transform, offsets, &config.verify)
+            } else {
+                verify(&pa, &pb, &transform, &config.verify)
+            };
+            (transform, v)
         };
         // The two polishes are independent: run them side by side.
         let ((mut transform, mut verification), searched) = rayon::join(

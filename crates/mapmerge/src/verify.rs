@@ -350,21 +350,40 @@ fn cell_of(grid: &OccupancyGrid, q: DVec2) -> Option<(usize, usize)> {
 /// farther than `wide` from any wall) and wall cells compared when `from`'s walls are mapped
 /// onto `onto` by `t`.
 fn wall_hits(
-    from: &PreparedMap,
-    onto: &PreparedMap,
+    from: (&PreparedMap, f64),
+    onto: (&PreparedMap, f64),
     t: &Rigid2,
     tol: f32,
     wide: f32,
 ) -> (usize, usize, usize, usize) {
+    let ((from, off_from), (onto, off_onto)) = (from, onto);
+    let corrected = off_from != 0.0 || off_onto != 0.0;
     let (mut hits, mut wide_hits, mut contra, mut total) = (0, 0, 0, 0);
     for &p in &from.wall_samples {
-        if let Some((x, y)) = cell_of(onto.grid, t.apply(p)) {
+        let m = if corrected {
+            t.apply(p + off_from * from.free_side(p.x as usize, p.y as usize))
+        } else {
+            t.apply(p)
+        };
+        if let Some((x, y)) = cell_of(onto.grid, m) {
             let state = onto.grid.state(x, y);
             if state == CellState::Unknown {
                 continue;
             }
             total += 1;
-            let d = onto.walls.distance(x, y);
+            let d = if corrected {
+                // Distance to the nearest wall cell moved by its map's offset.
+                match onto.walls.nearest(x, y) {
+                    Some(((qx, qy), _)) => {
+                        let q =
+                            DVec2::new(qx as f64, qy as f64) + off_onto * onto.free_side(qx, qy);
+                        (m - q).length() as f32
+                    }
+                    None => f32::INFINITY,
+                }
+            } else {
+                onto.walls.distance(x, y)
+            };
             if d <= tol {
                 hits += 1;
             }
@@ -399,9 +418,23 @@ pub fn verify(
     b_to_a: &Rigid2,
     config: &VerifyConfig,
 ) -> Verification {
+    verify_with_offsets(a, b, b_to_a, [0.0, 0.0], config)
+}
+
+/// [`verify`] with each map's walls moved towards their free side by its range-bias offset
+/// (`[a, b]`, pixels; see [`crate::refine::RefineConfig::range_bias`]) before they are
+/// compared.
+pub fn verify_with_offsets(
+    a: &PreparedMap,
+    b: &PreparedMap,
+    b_to_a: &Rigid2,
+    offsets: [f64; 2],
+    config: &VerifyConfig,
+) -> Verification {
     let (tol, wide) = (config.wall_tolerance_px, config.wide_tolerance_px);
-    let (h_ba, w_ba, c_ba, n_ba) = wall_hits(b, a, b_to_a, tol, wide);
-    let (h_ab, w_ab, c_ab, n_ab) = wall_hits(a, b, &b_to_a.inverse(), tol, wide);
+    let [off_a, off_b] = offsets;
+    let (h_ba, w_ba, c_ba, n_ba) = wall_hits((b, off_b), (a, off_a), b_to_a, tol, wide);
+    let (h_ab, w_ab, c_ab, n_ab) = wall_hits((a, off_a), (b, off_b), &b_to_a.inverse(), tol, wide);
     let wall_support = n_ba + n_ab;
     let share = |n: usize| {
         if wall_support == 0 {
@@ -460,5 +493,36 @@ pub fn verify(
         acceptance_index,
         overlap_cells,
         overlap_fraction: overlap_cells as f64 / smaller as f64,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::testmaps::{grown_room, room};
+
+    #[test]
+    fn walls_moved_by_their_offsets_agree_again() {
+        // B's outer walls sit 2 px further out than A's; the truth is the identity.
+        let (a, b) = (room(), grown_room(2));
+        let config = VerifyConfig {
+            wall_tolerance_px: 1.0,
+            ..VerifyConfig::default()
+        };
+        let (pa, pb) = (PreparedMap::new(&a, &config), PreparedMap::new(&b, &config));
+        let id = Rigid2::new(0.0, 0.0, 0.0);
+        let plain = verify(&pa, &pb, &id, &config);
+        let moved = verify_with_offsets(&pa, &pb, &id, [0.0, 2.0], &config);
+        assert!(plain.wall_lift < 0.5, "{plain:?}");
+        assert!(moved.wall_lift > 0.95, "{moved:?}");
+        // Zero offsets are exactly the plain verification.
+        assert_eq!(
+            verify_with_offsets(&pa, &pb, &id, [0.0, 0.0], &config),
+            plain
+        );
+        // Offsets move walls towards their free side: moving A's walls inwards instead takes
+        // them further from B's.
+        let wrong = verify_with_offsets(&pa, &pb, &id, [2.0, 0.0], &config);
+        assert!(wrong.wall_lift < plain.wall_lift + 0.05, "{wrong:?}");
     }
 }

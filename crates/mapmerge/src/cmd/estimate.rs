@@ -20,7 +20,8 @@ Output (--json): one JSON object on stdout.
   world            {x, y, yaw}: B's map frame in A's map frame (metres, yaw counter-clockwise),
                    ready to publish as a TF from A's map frame to B's
   inliers          correspondences within 3 px of the answer; inliers_by_kind splits them
-  confidence       wall lift of the answer: 0 is what a random placement scores, 1 is perfect
+  confidence       wall lift of the answer (each map's walls moved by the range-bias offset the
+                   refinement fitted): 0 is what a random placement scores, 1 is perfect
                    agreement of the walls; pairs are accepted from 0.65 (or 0.8 with walls
                    compared at 4 px), with acceptance index >= 0.88 and an overlap of at
                    least 10 % of the smaller map
