@@ -109,10 +109,11 @@ pub struct PreparedMap<'a> {
     pub wall_base_rate: f64,
     /// The same share for the wide tolerance.
     pub wide_base_rate: f64,
-    /// Per cell of the known window (see [`NearestOccupied::window`]), the angle (radians,
-    /// `[0, pi)`) of the wall normal at an occupied cell, NaN where the cell is not occupied or
-    /// the local wall has no clear direction.
-    pub normals: Vec<f32>,
+    /// Per cell of the known window (see [`NearestOccupied::window`]), the unit wall normal
+    /// `[x, y]` at an occupied cell (its angle in `[0, pi)`), NaN where the cell is not
+    /// occupied or the local wall has no clear direction. Stored as a vector so that lookups
+    /// in the refinement and verification loops need no trigonometry.
+    pub normals: Vec<[f32; 2]>,
     /// Per cell of the known window, the side of the wall normal on which free space lies
     /// (see [`PreparedMap::free_side`]).
     pub free_sides: Vec<i8>,
@@ -184,8 +185,8 @@ impl<'a> PreparedMap<'a> {
     /// Unit normal of the wall at occupied cell `(x, y)`, if it has a clear direction.
     #[inline]
     pub fn normal(&self, x: usize, y: usize) -> Option<DVec2> {
-        let a = self.normals[self.walls.index(x, y)?];
-        (!a.is_nan()).then(|| DVec2::from_angle(a as f64))
+        let [nx, ny] = self.normals[self.walls.index(x, y)?];
+        (!nx.is_nan()).then(|| DVec2::new(nx as f64, ny as f64))
     }
 
     /// Unit normal of the wall at occupied cell `(x, y)`, if it has a clear direction, and the
@@ -193,8 +194,8 @@ impl<'a> PreparedMap<'a> {
     #[inline]
     pub fn normal_and_side(&self, x: usize, y: usize) -> Option<(DVec2, f64)> {
         let i = self.walls.index(x, y)?;
-        let a = self.normals[i];
-        (!a.is_nan()).then(|| (DVec2::from_angle(a as f64), self.free_sides[i] as f64))
+        let [nx, ny] = self.normals[i];
+        (!nx.is_nan()).then(|| (DVec2::new(nx as f64, ny as f64), self.free_sides[i] as f64))
     }
 
     /// Unit normal of the wall at occupied cell `(x, y)` pointing to its free side: zero when
@@ -205,11 +206,11 @@ impl<'a> PreparedMap<'a> {
         let Some(i) = self.walls.index(x, y) else {
             return DVec2::ZERO;
         };
-        let (a, side) = (self.normals[i], self.free_sides[i]);
-        if a.is_nan() || side == 0 {
+        let ([nx, ny], side) = (self.normals[i], self.free_sides[i]);
+        if side == 0 {
             return DVec2::ZERO;
         }
-        DVec2::from_angle(a as f64) * side as f64
+        DVec2::new(nx as f64, ny as f64) * side as f64
     }
 }
 
@@ -218,7 +219,7 @@ impl<'a> PreparedMap<'a> {
 fn free_sides(
     grid: &OccupancyGrid,
     window: (usize, usize, usize, usize),
-    normals: &[f32],
+    normals: &[[f32; 2]],
 ) -> Vec<i8> {
     let (x0, y0, ww, _) = window;
     let free_towards = |p: DVec2, dir: DVec2| {
@@ -230,12 +231,12 @@ fn free_sides(
     normals
         .iter()
         .enumerate()
-        .map(|(i, &a)| {
-            if a.is_nan() {
+        .map(|(i, &[nx, ny])| {
+            if nx.is_nan() {
                 return 0;
             }
             let p = DVec2::new((x0 + i % ww) as f64, (y0 + i / ww) as f64);
-            let n = DVec2::from_angle(a as f64);
+            let n = DVec2::new(nx as f64, ny as f64);
             match (free_towards(p, n), free_towards(p, -n)) {
                 (true, false) => 1,
                 (false, true) => -1,
@@ -250,11 +251,11 @@ pub const FREE_SIDE_REACH: usize = 3;
 
 /// Wall normals from the second moments of the occupied cells in a 5 x 5 window: the wall runs
 /// along the principal axis, the normal across it. Blobs without a dominant axis get NaN.
-fn wall_normals(grid: &OccupancyGrid, window: (usize, usize, usize, usize)) -> Vec<f32> {
+fn wall_normals(grid: &OccupancyGrid, window: (usize, usize, usize, usize)) -> Vec<[f32; 2]> {
     const R: isize = 2;
     let (w, h) = (grid.width() as isize, grid.height() as isize);
     let (x0, y0, ww, wh) = window;
-    let mut out = vec![f32::NAN; ww * wh];
+    let mut out = vec![[f32::NAN; 2]; ww * wh];
     for y in y0 as isize..(y0 + wh) as isize {
         for x in x0 as isize..(x0 + ww) as isize {
             if grid.state(x as usize, y as usize) != CellState::Occupied {
@@ -291,8 +292,10 @@ fn wall_normals(grid: &OccupancyGrid, window: (usize, usize, usize, usize)) -> V
             }
             // Principal axis angle; the normal is a quarter turn from it.
             let axis = 0.5 * (2.0 * cxy).atan2(cxx - cyy);
-            out[(y as usize - y0) * ww + (x as usize - x0)] =
-                (axis + std::f64::consts::FRAC_PI_2).rem_euclid(std::f64::consts::PI) as f32;
+            let a = (axis + std::f64::consts::FRAC_PI_2).rem_euclid(std::f64::consts::PI) as f32;
+            // The vector of the f32 angle, as the angle was stored before (same normals).
+            let n = DVec2::from_angle(a as f64);
+            out[(y as usize - y0) * ww + (x as usize - x0)] = [n.x as f32, n.y as f32];
         }
     }
     out
