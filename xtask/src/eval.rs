@@ -241,8 +241,9 @@ struct Outcome {
     candidates: Vec<(mapmerge::verify::Verification, Option<f64>)>,
     timings: Option<mapmerge::Timings>,
     correspondences: Option<mapmerge::KindTotals>,
-    /// Scores of the true transform, and how far refinement started at the truth drifts
-    /// (displacement error in px): what the verification could reach at best.
+    /// Scores of the true transform (walls as mapped, no range-bias offsets), and how far
+    /// refinement started at the truth drifts (displacement error in px): what the
+    /// verification could reach at best.
     truth_verification: Option<mapmerge::verify::Verification>,
     truth_refined_drift_px: Option<f64>,
     /// Correspondences that agree with the truth (within the RANSAC threshold), by kind: how

@@ -8,8 +8,13 @@
 //!   `wall_tolerance_px` of an occupied cell of A (and symmetrically A onto B), lifted over the
 //!   share a random placement would reach (the fraction of known cells near walls); computed
 //!   at two tolerances, since a noisy sensor smears its walls into bands a few pixels wide;
+//! - *wall contradiction*: the share of compared wall cells that land in the other map's
+//!   free space, far from its walls (what tells a true rival from a twin);
 //! - *acceptance index* (Birk & Carpin 2006) over sampled cells known in both maps;
 //! - *overlap*: how many known cells the maps share under the hypothesis.
+//!
+//! [`verify_with_offsets`] scores the same with each map's walls moved by the range-bias
+//! offset its refinement fitted (see [`crate::refine::RefineConfig::range_bias`]).
 
 use grid_core::{CellState, DVec2, OccupancyGrid, Rigid2};
 
