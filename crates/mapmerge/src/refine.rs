@@ -96,14 +96,14 @@ fn collect(
     swap: Option<&Rigid2>,
     out: &mut Vec<Pair>,
 ) {
-    let (from, beta_from) = from;
+    let (from, off_from) = from;
     // Chunks are looked up in parallel and appended in order, so the pairs (and the sums over
     // them) do not depend on the thread count.
     let chunks: Vec<Vec<Pair>> = from
         .par_chunks(2048)
         .map(|chunk| {
             let mut part = Vec::with_capacity(chunk.len());
-            collect_chunk((chunk, beta_from), onto, to_onto, gate, swap, &mut part);
+            collect_chunk((chunk, off_from), onto, to_onto, gate, swap, &mut part);
             part
         })
         .collect();
@@ -121,9 +121,9 @@ fn collect_chunk(
     swap: Option<&Rigid2>,
     out: &mut Vec<Pair>,
 ) {
-    let (samples, beta_from) = from;
+    let (samples, off_from) = from;
     for &(p, sp) in samples {
-        let m = to_onto.apply(p + beta_from * sp);
+        let m = to_onto.apply(p + off_from * sp);
         let (x, y) = (m.x.round(), m.y.round());
         if x < 0.0 || y < 0.0 {
             continue;
@@ -214,7 +214,7 @@ pub fn refine_with_bias(
     config: &RefineConfig,
 ) -> (Rigid2, [f64; 2]) {
     let mut t = *b_to_a;
-    let (mut beta_a, mut beta_b) = (0.0, 0.0);
+    let (mut off_a, mut off_b) = (0.0, 0.0);
     // Each sample with its free side (zero without the range-bias model: nothing moves).
     let sided = |m: &PreparedMap| -> Vec<(DVec2, DVec2)> {
         strided(&m.wall_samples, config.max_points)
@@ -235,8 +235,8 @@ pub fn refine_with_bias(
         let gate = config.initial_gate_px + (config.final_gate_px - config.initial_gate_px) * f;
         let scale = config.robust_scale_px;
         pairs.clear();
-        collect((&wb, beta_b), a, &t, gate, None, &mut pairs);
-        collect((&wa, beta_a), b, &t.inverse(), gate, Some(&t), &mut pairs);
+        collect((&wb, off_b), a, &t, gate, None, &mut pairs);
+        collect((&wa, off_a), b, &t.inverse(), gate, Some(&t), &mut pairs);
         if pairs.len() < 10 {
             break;
         }
@@ -246,8 +246,8 @@ pub fn refine_with_bias(
         let (mut m, mut v) = ([[0.0; 3]; 3], [0.0; 3]);
         let (mut mb, mut vb) = ([[0.0; 2]; 2], [0.0; 2]);
         for pr in &pairs {
-            let x = t.apply(pr.p) + beta_b * rot.rotate(pr.sb);
-            let q = pr.q + beta_a * pr.sa;
+            let x = t.apply(pr.p) + off_b * rot.rotate(pr.sb);
+            let q = pr.q + off_a * pr.sa;
             let r = pr.n.dot(x - q);
             let w = 1.0 / (1.0 + (r / scale).powi(2));
             let j = [pr.n.dot((x - c).perp()), pr.n.x, pr.n.y];
@@ -256,6 +256,9 @@ pub fn refine_with_bias(
                     m[i][k] += w * j[i] * j[k];
                 }
                 v[i] -= w * j[i] * r;
+            }
+            if config.range_bias.is_none() {
+                continue;
             }
             // The bias is a smooth effect over many walls: fit it with a wider kernel.
             let wb = 1.0 / (1.0 + (r / BIAS_SCALE_PX).powi(2));
@@ -271,27 +274,26 @@ pub fn refine_with_bias(
             // A Gaussian prior pulls each offset towards 0 (no bias).
             mb[0][0] += prior;
             mb[1][1] += prior;
-            vb[0] -= prior * beta_b;
-            vb[1] -= prior * beta_a;
+            vb[0] -= prior * off_b;
+            vb[1] -= prior * off_a;
             let [mut db, mut da] = solve(mb, vb)?;
             // Offsets are never negative (a wall is not pulled towards its observer): where
             // one would be, hold it at 0 and fit the other alone.
-            if beta_a + da < 0.0 {
-                da = -beta_a;
+            if off_a + da < 0.0 {
+                da = -off_a;
                 db = (vb[0] - mb[0][1] * da) / mb[0][0];
-            } else if beta_b + db < 0.0 {
-                db = -beta_b;
+            } else if off_b + db < 0.0 {
+                db = -off_b;
                 da = (vb[1] - mb[1][0] * db) / mb[1][1];
             }
             Some([db, da])
         });
-        let [db, da] = bias_step.unwrap_or([0.0, 0.0]);
-        let step = solve(m, v).map(|x| [x[0], x[1], x[2], db, da]);
-        let Some([dt, dx, dy, db, da]) = step else {
+        let Some([dt, dx, dy]) = solve(m, v) else {
             break;
         };
-        beta_b = (beta_b + db).clamp(0.0, MAX_BETA);
-        beta_a = (beta_a + da).clamp(0.0, MAX_BETA);
+        let [db, da] = bias_step.unwrap_or([0.0, 0.0]);
+        off_b = (off_b + db).clamp(0.0, MAX_OFFSET_PX);
+        off_a = (off_a + da).clamp(0.0, MAX_OFFSET_PX);
         // Apply the increment: rotate about c by dθ, then shift by d.
         let step = Rigid2::new(dt, 0.0, 0.0);
         let about_c = Rigid2 {
@@ -311,14 +313,14 @@ pub fn refine_with_bias(
     {
         return (*b_to_a, [0.0, 0.0]);
     }
-    (t, [beta_a, beta_b])
+    (t, [off_a, off_b])
 }
 
 /// Scale (pixels) of the Cauchy weight of the bias fit.
 const BIAS_SCALE_PX: f64 = 1.0;
 
 /// Largest range-bias offset, in pixels (the walls of a 10 % noise sensor at 80 cells).
-const MAX_BETA: f64 = 8.0;
+const MAX_OFFSET_PX: f64 = 8.0;
 
 #[cfg(test)]
 mod tests {
@@ -339,25 +341,6 @@ mod tests {
             assert!((got - want).abs() < 1e-12, "{x:?}");
         }
         assert_eq!(solve([[1.0, 2.0], [2.0, 4.0]], [1.0, 2.0]), None);
-    }
-
-    #[test]
-    fn free_sides_point_into_the_room() {
-        let a = room();
-        let pa = PreparedMap::new(&a, &VerifyConfig::default());
-        // Outer walls are seen from inside; the half wall from both sides, so it has none.
-        let side = |x, y| pa.free_side(x, y);
-        assert!(
-            (side(10, 30) - DVec2::new(1.0, 0.0)).length() < 1e-6,
-            "{}",
-            side(10, 30)
-        );
-        assert!((side(109, 30) - DVec2::new(-1.0, 0.0)).length() < 1e-6);
-        assert!((side(40, 10) - DVec2::new(0.0, 1.0)).length() < 1e-6);
-        assert!((side(40, 89) - DVec2::new(0.0, -1.0)).length() < 1e-6);
-        assert_eq!(side(80, 50), DVec2::ZERO);
-        // Not a wall cell.
-        assert_eq!(side(40, 40), DVec2::ZERO);
     }
 
     #[test]

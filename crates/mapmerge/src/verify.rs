@@ -510,6 +510,25 @@ mod tests {
     use crate::testmaps::{grown_room, room};
 
     #[test]
+    fn free_sides_point_into_the_room() {
+        let a = room();
+        let pa = PreparedMap::new(&a, &VerifyConfig::default());
+        // Outer walls are seen from inside; the half wall from both sides, so it has none.
+        let side = |x, y| pa.free_side(x, y);
+        assert!(
+            (side(10, 30) - DVec2::new(1.0, 0.0)).length() < 1e-6,
+            "{}",
+            side(10, 30)
+        );
+        assert!((side(109, 30) - DVec2::new(-1.0, 0.0)).length() < 1e-6);
+        assert!((side(40, 10) - DVec2::new(0.0, 1.0)).length() < 1e-6);
+        assert!((side(40, 89) - DVec2::new(0.0, -1.0)).length() < 1e-6);
+        assert_eq!(side(80, 50), DVec2::ZERO);
+        // Not a wall cell.
+        assert_eq!(side(40, 40), DVec2::ZERO);
+    }
+
+    #[test]
     fn walls_moved_by_their_offsets_agree_again() {
         // B's outer walls sit 2 px further out than A's; the truth is the identity.
         let (a, b) = (room(), grown_room(2));
