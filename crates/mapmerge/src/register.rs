@@ -41,12 +41,12 @@ pub struct PairConfig {
     /// correlation ([`crate::global::twins`], with the `global` settings or their
     /// defaults), and each twin is refined and verified like a global-search candidate. A
     /// row of alike rooms, or a room or rubble field that looks the same turned, fits a twin
-    /// about as well, and a twin that passes verification on its own makes the pair
-    /// ambiguous (unless it contradicts the maps more, see
-    /// [`VerifyConfig::max_contradiction_excess`]): it is declined instead of answered by a
-    /// coin toss. Like the sweep, the probes are skipped when the best is a feature-based
-    /// candidate with a good fit ([`SweepConfig::confident_wall_lift`]): keypoints that agree
-    /// do not repeat with the walls. Default on.
+    /// about as well, and a twin that fits about as well as the best makes the pair ambiguous
+    /// (the rule of [`VerifyConfig::max_ambiguity`], including its contradiction gate): it is
+    /// declined instead of answered by a coin toss. Like the sweep, the probes are skipped
+    /// when the best is a feature-based candidate with a good fit
+    /// ([`SweepConfig::confident_wall_lift`]): keypoints that agree do not repeat with the
+    /// walls. Default on.
     pub symmetry_probes: bool,
     /// Score each candidate with the range-bias offsets its refinement fitted applied to the
     /// walls (see [`crate::verify::verify_with_offsets`]).
@@ -151,6 +151,21 @@ impl KindTotals {
         }
         t
     }
+}
+
+/// Whether candidate `c`, placed clearly apart from the best (`best` its scores), is a rival
+/// that makes the pair ambiguous ([`VerifyConfig::max_ambiguity`]): it passes, scores almost
+/// as well or fits its (smaller) overlap at least as well, and does not put clearly more
+/// walls into the other map's free space ([`VerifyConfig::max_contradiction_excess`]).
+///
+/// A twin from the symmetry probes is judged by the same rule. At 9c48d15 every twin that
+/// passed was a rival, which declined exact copies of small rooms whose quarter-turned twin
+/// fits worse (wall lift 0.90 against 1.00, score 257 against 621).
+fn rivals(best: &Verification, c: &Candidate, config: &VerifyConfig) -> bool {
+    let v = &c.verification;
+    c.accepted
+        && (v.score() >= config.max_ambiguity * best.score() || v.wall_lift >= best.wall_lift)
+        && v.wall_contradiction <= best.wall_contradiction + config.max_contradiction_excess
 }
 
 fn ms(t: Instant) -> f64 {
@@ -342,16 +357,7 @@ pub fn register_with(
     };
     let rival = candidates.first().filter(|b| b.accepted).and_then(|best| {
         candidates.iter().skip(1).find(|c| {
-            // A twin that passes on its own is a rival whatever its score (its overlap, and so
-            // its support, differs from the best's by construction), unless it puts clearly
-            // more walls into the other map's free space.
-            c.accepted
-                && (c.verification.score()
-                    >= config.verify.max_ambiguity * best.verification.score()
-                    || c.verification.wall_lift >= best.verification.wall_lift
-                    || c.origin == "symmetry")
-                && c.verification.wall_contradiction
-                    <= best.verification.wall_contradiction + config.verify.max_contradiction_excess
+            rivals(&best.verification, c, &config.verify)
                 && apart(&c.transform, &best.transform) > config.verify.distinct_px
         })
     });
@@ -514,6 +520,40 @@ mod tests {
             "{:?}",
             r.candidates
         );
+    }
+
+    #[test]
+    fn a_twin_is_a_rival_only_if_it_fits_about_as_well() {
+        let scores = |lift: f64, support: usize, contradiction: f64| Verification {
+            wall_lift: lift,
+            wall_support: support,
+            wall_contradiction: contradiction,
+            acceptance_index: 0.99,
+            ..Verification::default()
+        };
+        let twin = |verification: Verification| Candidate {
+            transform: Rigid2::new(1.6, 40.0, 0.0),
+            ransac_inliers: 0,
+            ransac_confidence: 0.0,
+            verification,
+            accepted: true,
+            origin: "symmetry",
+        };
+        let config = VerifyConfig::default();
+        // The exact copy of a small room (a case proptest found): the best fits every wall,
+        // the quarter-turned twin passes but fits 0.90 of a smaller overlap.
+        let best = scores(1.0, 622, 0.0);
+        assert!(!rivals(&best, &twin(scores(0.90, 292, 0.027)), &config));
+        // Scoring 0.6 of the best, or fitting as well, makes it a rival ...
+        assert!(rivals(&best, &twin(scores(0.90, 430, 0.027)), &config));
+        assert!(rivals(&best, &twin(scores(1.0, 200, 0.0)), &config));
+        // ... unless it puts more than 0.05 more of its walls into free space, or fails.
+        assert!(!rivals(&best, &twin(scores(1.0, 622, 0.06)), &config));
+        let failed = Candidate {
+            accepted: false,
+            ..twin(best)
+        };
+        assert!(!rivals(&best, &failed, &config));
     }
 
     #[test]

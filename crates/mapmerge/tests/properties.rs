@@ -6,14 +6,28 @@ use mapmerge::{RegisterConfig, register};
 use mapsim::strategies::{PairParams, Worlds, map_pair};
 use proptest::prelude::*;
 
+/// The proptest seed: `MAPMERGE_PROPTEST_SEED` if set to a number, else `default`.
+fn seed_from_env(default: u64) -> u64 {
+    env_number("MAPMERGE_PROPTEST_SEED").unwrap_or(default)
+}
+
+/// The number of cases: `PROPTEST_CASES` if set to a number, else `default`.
+fn cases_from_env(default: u32) -> u32 {
+    env_number("PROPTEST_CASES").map_or(default, |n| n.min(u32::MAX as u64) as u32)
+}
+
+fn env_number(name: &str) -> Option<u64> {
+    std::env::var(name).ok().and_then(|s| s.trim().parse().ok())
+}
+
 proptest! {
     // A fixed seed makes every run, CI's included, try the same cases, so a red run can be
-    // reproduced. A random-seeded CI run on 2026-12-01 found a copy of a 111-cell-wide map
-    // registered 0.72 degrees off (bound 0.5); that case is not reproduced yet (see the issue
-    // notes). Change the seed locally to explore other cases.
+    // reproduced. `MAPMERGE_PROPTEST_SEED=N` explores other cases (proptest's own
+    // PROPTEST_RNG_SEED is ignored while the config fixes the seed), `PROPTEST_CASES=N` more
+    // of them.
     #![proptest_config(ProptestConfig {
-        cases: 8,
-        rng_seed: proptest::test_runner::RngSeed::Fixed(7),
+        cases: cases_from_env(8),
+        rng_seed: proptest::test_runner::RngSeed::Fixed(seed_from_env(7)),
         ..ProptestConfig::default()
     })]
 
