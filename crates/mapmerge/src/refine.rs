@@ -217,16 +217,12 @@ pub fn refine_with_bias(
     let (mut off_a, mut off_b) = (0.0, 0.0);
     // Each sample with its free side (zero without the range-bias model: nothing moves).
     let sided = |m: &PreparedMap| -> Vec<(DVec2, DVec2)> {
-        strided(&m.wall_samples, config.max_points)
-            .into_iter()
-            .map(|p| {
-                let side = match config.range_bias {
-                    Some(_) => m.free_side(p.x as usize, p.y as usize),
-                    None => DVec2::ZERO,
-                };
-                (p, side)
-            })
-            .collect()
+        let samples = m.wall_samples.iter().copied();
+        let all: Vec<(DVec2, DVec2)> = match config.range_bias {
+            Some(_) => samples.zip(m.wall_sides.iter().copied()).collect(),
+            None => samples.map(|p| (p, DVec2::ZERO)).collect(),
+        };
+        strided(&all, config.max_points)
     };
     let (wa, wb) = (sided(a), sided(b));
     let mut pairs = Vec::with_capacity(wa.len() + wb.len());

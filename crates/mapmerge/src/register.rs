@@ -87,8 +87,42 @@ pub struct Candidate {
     pub verification: Verification,
     /// Whether it passes the verification thresholds.
     pub accepted: bool,
-    /// Where the hypothesis came from: `ransac`, `global` (Hough spectrum) or `sweep`.
-    pub origin: &'static str,
+    /// Where the hypothesis came from.
+    pub origin: Origin,
+}
+
+/// Which stage proposed a candidate; serialised in lower case (`"ransac"`, ...), as the
+/// `hypothesis` field of `mapmerge estimate --json`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Origin {
+    /// A RANSAC hypothesis from keypoint and component correspondences.
+    Ransac,
+    /// The global search (Hough spectrum and correlation), run when no RANSAC candidate passed.
+    Global,
+    /// The rotation sweep of coarse correlation images.
+    Sweep,
+    /// A symmetry probe: the best candidate's angle, or that angle turned by a quarter, half or
+    /// three quarters of a turn, with the best correlation translations.
+    Symmetry,
+}
+
+impl Origin {
+    /// The lower-case name, as serialised.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Origin::Ransac => "ransac",
+            Origin::Global => "global",
+            Origin::Sweep => "sweep",
+            Origin::Symmetry => "symmetry",
+        }
+    }
+}
+
+impl std::fmt::Display for Origin {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.pad(self.as_str())
+    }
 }
 
 /// Wall-clock time of each stage, in milliseconds.
@@ -233,7 +267,7 @@ pub fn register_with(
     // correlative local search around it (keypoints, or the global search's coarse grid, can
     // put it a few pixels off, outside ICP's narrow basin); the polished pose the maps agree
     // with more wins. Global hypotheses refine with their own, wider-gated configuration.
-    let check = |model: &Rigid2, refine_config: &RefineConfig, origin| {
+    let check = |model: &Rigid2, refine_config: &RefineConfig, origin: Origin| {
         let polish = |start: &Rigid2| {
             let (transform, offsets) = refine_with_bias(&pa, &pb, start, refine_config);
             let transform = transform.normalized();
@@ -272,13 +306,13 @@ pub fn register_with(
         .map(|h| Candidate {
             ransac_inliers: h.inliers_count,
             ransac_confidence: h.confidence,
-            ..check(&h.model, &config.refine, "ransac")
+            ..check(&h.model, &config.refine, Origin::Ransac)
         })
         .collect();
     timings.verify_ms = ms(t0);
     // The whole-map searches: their placements are checked like the feature-based ones, with
     // the global refinement (they come from a coarse grid).
-    let search = |generate: &dyn Fn(&mut Vec<Rigid2>), origin| {
+    let search = |generate: &dyn Fn(&mut Vec<Rigid2>), origin: Origin| {
         let t0 = Instant::now();
         let mut models = Vec::new();
         generate(&mut models);
@@ -291,7 +325,10 @@ pub fn register_with(
     if let Some(global) = &config.global
         && !candidates.iter().any(|c| c.accepted)
     {
-        let (found, t) = search(&|out| global_hypotheses(&pa, &pb, global, out), "global");
+        let (found, t) = search(
+            &|out| global_hypotheses(&pa, &pb, global, out),
+            Origin::Global,
+        );
         candidates.extend(found);
         timings.global_ms = t;
     }
@@ -303,7 +340,7 @@ pub fn register_with(
             s.confident_wall_lift
         });
     let confident = |c: &Candidate| {
-        c.accepted && c.origin == "ransac" && c.verification.wall_lift >= confident_wall_lift
+        c.accepted && c.origin == Origin::Ransac && c.verification.wall_lift >= confident_wall_lift
     };
     // The sweep runs unless a feature-based candidate passed with a good fit. Keypoint matches
     // that agree and walls that agree are two kinds of evidence; one kind alone (a
@@ -313,7 +350,7 @@ pub fn register_with(
     if let Some(sweep) = &config.sweep
         && !candidates.iter().any(confident)
     {
-        let (found, t) = search(&|out| sweep_hypotheses(&pa, &pb, sweep, out), "sweep");
+        let (found, t) = search(&|out| sweep_hypotheses(&pa, &pb, sweep, out), Origin::Sweep);
         candidates.extend(found);
         timings.sweep_ms = t;
     }
@@ -339,7 +376,7 @@ pub fn register_with(
         );
         let found: Vec<Candidate> = probes
             .par_iter()
-            .map(|m| check(m, &config.global_refine, "symmetry"))
+            .map(|m| check(m, &config.global_refine, Origin::Symmetry))
             .collect();
         candidates.extend(found);
         rank(&mut candidates);
@@ -516,7 +553,7 @@ mod tests {
         assert!(
             r.candidates
                 .iter()
-                .any(|c| c.accepted && c.origin == "symmetry"),
+                .any(|c| c.accepted && c.origin == Origin::Symmetry),
             "{:?}",
             r.candidates
         );
@@ -537,7 +574,7 @@ mod tests {
             ransac_confidence: 0.0,
             verification,
             accepted: true,
-            origin: "symmetry",
+            origin: Origin::Symmetry,
         };
         let config = VerifyConfig::default();
         // The exact copy of a small room (a case proptest found): the best fits every wall,

@@ -106,6 +106,8 @@ pub struct PreparedMap<'a> {
     pub walls: NearestOccupied,
     /// Sampled occupied cells (pixel centres).
     pub wall_samples: Vec<DVec2>,
+    /// The free side ([`PreparedMap::free_side`]) of each of `wall_samples`, in order.
+    pub wall_sides: Vec<DVec2>,
     /// Sampled known cells (pixel centres).
     pub known_samples: Vec<DVec2>,
     /// Number of known (free or occupied) cells.
@@ -125,7 +127,7 @@ pub struct PreparedMap<'a> {
 }
 
 /// At most `max` of `points`, evenly strided (deterministic).
-pub(crate) fn strided(points: &[DVec2], max: usize) -> Vec<DVec2> {
+pub(crate) fn strided<T: Copy>(points: &[T], max: usize) -> Vec<T> {
     if points.len() <= max {
         return points.to_vec();
     }
@@ -174,24 +176,30 @@ impl<'a> PreparedMap<'a> {
             }
         };
         let (wall_base_rate, wide_base_rate) = (rate(near), rate(near_wide));
-        Self {
+        let mut prepared = Self {
             grid,
             walls,
             wall_samples: strided(&occ, config.max_samples),
+            wall_sides: Vec::new(),
             known_samples: strided(&known, config.max_samples),
             known_cells,
             wall_base_rate,
             wide_base_rate,
             normals,
             free_sides,
-        }
+        };
+        prepared.wall_sides = prepared
+            .wall_samples
+            .iter()
+            .map(|p| prepared.free_side(p.x as usize, p.y as usize))
+            .collect();
+        prepared
     }
 
     /// Unit normal of the wall at occupied cell `(x, y)`, if it has a clear direction.
     #[inline]
     pub fn normal(&self, x: usize, y: usize) -> Option<DVec2> {
-        let [nx, ny] = self.normals[self.walls.index(x, y)?];
-        (!nx.is_nan()).then(|| DVec2::new(nx as f64, ny as f64))
+        self.normal_and_side(x, y).map(|(n, _)| n)
     }
 
     /// Unit normal of the wall at occupied cell `(x, y)`, if it has a clear direction, and the
@@ -208,14 +216,8 @@ impl<'a> PreparedMap<'a> {
     /// [`FREE_SIDE_REACH`] cells).
     #[inline]
     pub fn free_side(&self, x: usize, y: usize) -> DVec2 {
-        let Some(i) = self.walls.index(x, y) else {
-            return DVec2::ZERO;
-        };
-        let ([nx, ny], side) = (self.normals[i], self.free_sides[i]);
-        if side == 0 {
-            return DVec2::ZERO;
-        }
-        DVec2::new(nx as f64, ny as f64) * side as f64
+        self.normal_and_side(x, y)
+            .map_or(DVec2::ZERO, |(n, side)| n * side)
     }
 }
 
@@ -367,9 +369,9 @@ fn wall_hits(
     let ((from, off_from), (onto, off_onto)) = (from, onto);
     let corrected = off_from != 0.0 || off_onto != 0.0;
     let (mut hits, mut wide_hits, mut contra, mut total) = (0, 0, 0, 0);
-    for &p in &from.wall_samples {
+    for (&p, &side) in from.wall_samples.iter().zip(&from.wall_sides) {
         let m = if corrected {
-            t.apply(p + off_from * from.free_side(p.x as usize, p.y as usize))
+            t.apply(p + off_from * side)
         } else {
             t.apply(p)
         };

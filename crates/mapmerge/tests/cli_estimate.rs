@@ -268,7 +268,7 @@ fn registers_from_area_evidence_alone() {
     };
     let r = register_with(&a, &b, &sources, &config);
     let c = r.accepted.expect("accepted from blob evidence");
-    assert_eq!(c.origin, "ransac");
+    assert_eq!(c.origin, mapmerge::Origin::Ransac);
     assert_eq!(r.correspondences.intensity, 0);
     assert!(r.inliers.area >= 2, "{:?}", r.inliers);
     assert!(rotation_error_deg(&c.transform, &truth) < 0.5);
