@@ -70,6 +70,13 @@ pub struct EvalArgs {
     /// calibration experiments.
     #[arg(long)]
     sweep_size: Option<usize>,
+    /// Override the wall lift of a RANSAC answer above which the rotation sweep is skipped
+    /// (default: the library's), for calibration experiments.
+    #[arg(long)]
+    confident_lift: Option<f64>,
+    /// Skip the polish of clean candidates (to measure what it adds).
+    #[arg(long)]
+    no_polish: bool,
     /// Override the refinement's range-bias prior weight (`0` or less turns the model off;
     /// default: the library's), to measure what it adds.
     #[arg(long)]
@@ -284,6 +291,12 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
         if let Some(n) = args.sweep_size {
             sweep.coarse_size = n;
         }
+        if let Some(l) = args.confident_lift {
+            sweep.confident_wall_lift = l;
+        }
+    }
+    if args.no_polish {
+        config.pair.polish = None;
     }
     config
 }

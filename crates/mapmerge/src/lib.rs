@@ -16,6 +16,6 @@ pub mod verify;
 mod testmaps;
 
 pub use register::{
-    Candidate, KindTotals, Method, Origin, PairConfig, RegisterConfig, Registration, Timings,
-    register, register_with,
+    Candidate, KindTotals, Method, Origin, PairConfig, PolishConfig, RegisterConfig, Registration,
+    Timings, register, register_with,
 };

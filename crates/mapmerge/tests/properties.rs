@@ -33,6 +33,12 @@ proptest! {
 
     /// A simulated robot's map and a copy moved by a random rigid transform (any angle,
     /// sub-pixel translation) are registered within 1 px and 0.5 degrees.
+    ///
+    /// The angle bound is close to what the copy keeps: the copy is resampled cell by cell,
+    /// so a map about 100 cells across turned by less than about 0.5 degrees from a quarter
+    /// turn is, cell for cell, that quarter turn with a step or two. At 100 cases per seed,
+    /// seeds 1-20 pass except 14 (one copy 0.52 degrees off); before the polish of clean
+    /// candidates and the higher probe bar (2026-12-01) seeds 5 and 11 failed too.
     #[test]
     fn random_rigid_copies_are_recovered(
         (map, _, _) in map_pair(PairParams { size: 200..=280, noise: 0.0..=0.1, beams: vec![360], ..PairParams::default() }),
