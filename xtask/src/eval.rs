@@ -74,7 +74,7 @@ pub struct EvalArgs {
     /// (default: the library's), for calibration experiments.
     #[arg(long)]
     confident_lift: Option<f64>,
-    /// Skip the polish of clean candidates (to measure what it adds).
+    /// Skip the polish of a clean best answer (to measure what it adds).
     #[arg(long)]
     no_polish: bool,
     /// Override the refinement's range-bias prior weight (`0` or less turns the model off;

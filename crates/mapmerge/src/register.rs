@@ -53,8 +53,8 @@ pub struct PairConfig {
     /// RANSAC answer refined to 3.5 degrees off at wall lift 0.85, was found by the probe at
     /// its angle (lift 1.0). On `cargo xtask eval --suites overlap,zero,paper,real,noise
     /// --seed 7` the probes then run on more pairs, and no row's success changed (0.7
-    /// overlap and paper medians moved by 0.02 and 0.06 px); the sweep at 0.9 instead
-    /// cost about twice as much time per pair.
+    /// overlap and paper medians moved by 0.02 and 0.06 px) at up to 0.2 s more per pair;
+    /// the sweep at 0.9 instead cost 0.35-0.65 s more.
     pub symmetry_confident_wall_lift: f64,
     /// Score each candidate with the range-bias offsets its refinement fitted applied to the
     /// walls (see [`crate::verify::verify_with_offsets`]).
@@ -64,9 +64,9 @@ pub struct PairConfig {
     pub polish: Option<PolishConfig>,
 }
 
-/// The polish of a clean answer: when the best candidate's walls agree almost everywhere, there is
-/// no smeared wall band for the refinement's narrow robust kernel to guard against, and the
-/// kernel then only locks onto the cells that happen to coincide. On a rotated copy of a
+/// The polish of a clean answer: when the best candidate's walls agree almost everywhere,
+/// there is no smeared wall band for the refinement's narrow robust kernel to guard against,
+/// and the kernel then only locks onto the cells that happen to coincide. On a rotated copy of a
 /// small map, resampled cell by cell, the pixel-exact quarter turn is such a lock: copies
 /// turned by 90.8 and 95.2 degrees came out 0.7-0.8 degrees off. A few more iterations with
 /// a wider kernel and without range-bias offsets (walls that agree have none) average over
@@ -74,10 +74,10 @@ pub struct PairConfig {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PolishConfig {
     /// The best candidate is polished at or above this wall lift, and the polish is kept
-    /// only if it stays there (and passes). Default 0.97: above every answer on the noisy suites of `cargo xtask eval
-    /// --suites overlap,zero,paper,real,noise --seed 7` (at most 0.94, in the paper preset's
-    /// row), where the narrow kernel is what keeps smeared walls from biasing the pose; the
-    /// rotated copies of the property tests score 1.
+    /// only if it stays there (and passes). Default 0.97: above every answer on the noisy
+    /// suites of `cargo xtask eval --suites overlap,zero,paper,real,noise --seed 7` (at most
+    /// 0.94, in the paper preset's row), where the narrow kernel is what keeps smeared walls
+    /// from biasing the pose; the rotated copies of the property tests score 1.
     pub min_wall_lift: f64,
     /// The refinement. Default: gate 3 px shrinking to 2 px, Cauchy scale 0.5 px, no range
     /// bias, at most 10 iterations (the same outcome as 30 on the property seeds).
@@ -317,7 +317,7 @@ pub fn register_with(
     // put it a few pixels off, outside ICP's narrow basin); the polished pose the maps agree
     // with more wins. Global hypotheses refine with their own, wider-gated configuration.
     let check = |model: &Rigid2, refine_config: &RefineConfig, origin: Origin| {
-        let polish = |start: &Rigid2| {
+        let refined = |start: &Rigid2| {
             let (transform, offsets) = refine_with_bias(&pa, &pb, start, refine_config);
             let transform = transform.normalized();
             let v = if config.offsets_in_verification {
@@ -329,11 +329,11 @@ pub fn register_with(
         };
         // The two polishes are independent: run them side by side.
         let ((mut transform, mut verification), searched) = rayon::join(
-            || polish(model),
+            || refined(model),
             || {
                 let sc = config.search.as_ref()?;
                 let moved = local_search(&pa, &pb, model, sc);
-                (moved != *model).then(|| polish(&moved))
+                (moved != *model).then(|| refined(&moved))
             },
         );
         if let Some((t, v)) = searched {

@@ -75,10 +75,12 @@ proptest! {
     /// rooms where a placement tens of pixels off fits the walls as well as the truth (wall lift
     /// 0.80-0.88, acceptance index 0.97-0.99, overlap 0.86-0.95) and is accepted. The case of
     /// 2026-12-01 that was the truth turned by 180 degrees (83 px off, from the global search)
-    /// no longer fails: the symmetry probes propose the turned twin. Proptest then finds
-    /// others, 52 and 85 px off, RANSAC answers at wall lift 0.80-0.83: at or above the
-    /// confident bar (`SweepConfig::confident_wall_lift`), so neither the sweep nor the probes
-    /// look for a rival. The failing cases are kept in `properties.proptest-regressions`,
+    /// no longer fails: the symmetry probes propose the turned twin. Proptest then found
+    /// others, 52 and 85 px off, RANSAC answers at wall lift 0.80-0.83, above the bar that
+    /// skipped the sweep and the probes. Since the probes run up to wall lift 0.9
+    /// (`PairConfig::symmetry_confident_wall_lift`, eab2248), the first failure is a sweep
+    /// answer 74 px off at wall lift 0.93: its twins were probed, and none fits as well.
+    /// The failing cases are kept in `properties.proptest-regressions`,
     /// so `cargo test -p mapmerge --test properties -- --ignored` shows them first.
     #[test]
     #[ignore = "known false accepts on small repetitive maps (see the doc comment)"]
