@@ -217,12 +217,15 @@ pub fn refine_with_bias(
     let (mut off_a, mut off_b) = (0.0, 0.0);
     // Each sample with its free side (zero without the range-bias model: nothing moves).
     let sided = |m: &PreparedMap| -> Vec<(DVec2, DVec2)> {
-        let samples = m.wall_samples.iter().copied();
-        let all: Vec<(DVec2, DVec2)> = match config.range_bias {
-            Some(_) => samples.zip(m.wall_sides.iter().copied()).collect(),
-            None => samples.map(|p| (p, DVec2::ZERO)).collect(),
-        };
-        strided(&all, config.max_points)
+        // Striding both lists of equal length picks the same entries of each.
+        let samples = strided(&m.wall_samples, config.max_points);
+        match config.range_bias {
+            Some(_) => samples
+                .into_iter()
+                .zip(strided(&m.wall_sides, config.max_points))
+                .collect(),
+            None => samples.into_iter().map(|p| (p, DVec2::ZERO)).collect(),
+        }
     };
     let (wa, wb) = (sided(a), sided(b));
     let mut pairs = Vec::with_capacity(wa.len() + wb.len());
