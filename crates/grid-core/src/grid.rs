@@ -233,11 +233,10 @@ impl OccupancyGrid {
     /// concerns known cells can skip the rest of a big canvas.
     pub fn known_bounds(&self, margin: usize) -> Option<(usize, usize, usize, usize)> {
         let (w, h) = (self.width(), self.height());
-        let known = |c: &u8| Self::classify(*c) != CellState::Unknown;
         let (mut x0, mut y0, mut x1, mut y1) = (usize::MAX, usize::MAX, 0usize, 0usize);
         for (y, row) in self.cells.chunks_exact(w.max(1)).enumerate() {
-            if let Some(first) = row.iter().position(known) {
-                let last = row.iter().rposition(known).unwrap_or(first);
+            if let Some(first) = first_known(row) {
+                let last = last_known(row).unwrap_or(first);
                 x0 = x0.min(first);
                 x1 = x1.max(last);
                 y0 = y0.min(y);
@@ -294,6 +293,14 @@ impl OccupancyGrid {
         }
     }
 
+    /// Whether a raw cell value is known (free or occupied per [`Self::classify`]), without
+    /// branches, so that a scan over many cells vectorises.
+    #[inline]
+    fn is_known(cell: u8) -> bool {
+        (cell <= Self::FREE_MAX_PERCENT)
+            | (cell.wrapping_sub(Self::OCCUPIED_MIN_PERCENT) <= 100 - Self::OCCUPIED_MIN_PERCENT)
+    }
+
     /// Classified state at `(x, y)`; outside the grid is unknown.
     #[inline]
     pub fn state(&self, x: usize, y: usize) -> CellState {
@@ -346,6 +353,44 @@ impl OccupancyGrid {
     }
 }
 
+/// Cells per block of the known-cell scans: each block is tested as a whole (a branch-free
+/// fold, which vectorises) before the exact cell is looked for in it.
+const SCAN_BLOCK: usize = 64;
+
+/// Index of the first known cell of `row`.
+fn first_known(row: &[u8]) -> Option<usize> {
+    row.chunks(SCAN_BLOCK).enumerate().find_map(|(i, block)| {
+        let any = block
+            .iter()
+            .fold(false, |a, &c| a | OccupancyGrid::is_known(c));
+        any.then(|| {
+            i * SCAN_BLOCK
+                + block
+                    .iter()
+                    .position(|&c| OccupancyGrid::is_known(c))
+                    .unwrap_or(0)
+        })
+    })
+}
+
+/// Index of the last known cell of `row`.
+fn last_known(row: &[u8]) -> Option<usize> {
+    row.rchunks(SCAN_BLOCK).enumerate().find_map(|(i, block)| {
+        let any = block
+            .iter()
+            .fold(false, |a, &c| a | OccupancyGrid::is_known(c));
+        // Blocks but the last one (at the row's start) are full, so this one starts here.
+        let start = row.len() - i * SCAN_BLOCK - block.len();
+        any.then(|| {
+            start
+                + block
+                    .iter()
+                    .rposition(|&c| OccupancyGrid::is_known(c))
+                    .unwrap_or(0)
+        })
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -366,6 +411,29 @@ mod tests {
         let empty =
             OccupancyGrid::from_cells(w, h, 0.05, Pose2::default(), vec![UNKNOWN; w * h]).unwrap();
         assert_eq!(empty.known_bounds(3), None);
+    }
+
+    #[test]
+    fn the_known_scans_agree_with_classify() {
+        for c in 0..=255u8 {
+            assert_eq!(
+                OccupancyGrid::is_known(c),
+                OccupancyGrid::classify(c) != CellState::Unknown,
+                "value {c}"
+            );
+        }
+        // Rows longer and shorter than a scan block, known cells at block edges.
+        for len in [1usize, 5, 63, 64, 65, 130, 200] {
+            for (a, b) in [(0, 0), (0, len - 1), (len / 2, len / 2), (len - 1, len - 1)] {
+                let mut row = vec![UNKNOWN; len];
+                row[a] = 0;
+                row[b] = 100;
+                assert_eq!(first_known(&row), Some(a), "len {len}, {a}..{b}");
+                assert_eq!(last_known(&row), Some(b), "len {len}, {a}..{b}");
+            }
+            assert_eq!(first_known(&vec![50; len]), None);
+            assert_eq!(last_known(&vec![UNKNOWN; len]), None);
+        }
     }
 
     #[test]
