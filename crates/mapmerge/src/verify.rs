@@ -137,35 +137,84 @@ pub(crate) fn strided<T: Copy>(points: &[T], max: usize) -> Vec<T> {
         .collect()
 }
 
+/// [`strided`] over a sequence seen one item at a time, without storing it: offered the `len`
+/// items in order, it keeps exactly those `strided` would pick.
+struct StridedPicker {
+    /// Items offered so far.
+    seen: usize,
+    /// Picks made so far.
+    made: usize,
+    /// The number of picks to make, and the item index of pick `k` is `floor(k * step)`.
+    max: usize,
+    step: f64,
+    picked: Vec<DVec2>,
+}
+
+impl StridedPicker {
+    fn new(len: usize, max: usize) -> Self {
+        let max = len.min(max);
+        let step = if max == 0 {
+            1.0
+        } else {
+            len as f64 / max as f64
+        };
+        Self {
+            seen: 0,
+            made: 0,
+            max,
+            step,
+            picked: Vec::with_capacity(max),
+        }
+    }
+
+    #[inline]
+    fn offer(&mut self, p: DVec2) {
+        // With at most `max` items the step is 1 and every item is picked, as `strided` does.
+        if self.made < self.max && self.seen == (self.made as f64 * self.step) as usize {
+            self.picked.push(p);
+            self.made += 1;
+        }
+        self.seen += 1;
+    }
+}
+
 impl<'a> PreparedMap<'a> {
     /// Precompute the nearest-wall transform and the samples of `grid`.
     pub fn new(grid: &'a OccupancyGrid, config: &VerifyConfig) -> Self {
         let walls = NearestOccupied::new(grid);
         // Everything outside the known window is unknown.
         let (x0, y0, ww, wh) = walls.window();
-        let (mut occ, mut known) = (Vec::new(), Vec::new());
+        // Count first, then pick the samples: the known cells of a big map run into millions,
+        // and only `max_samples` of them are kept.
+        let cells = (y0..y0 + wh).flat_map(|y| (x0..x0 + ww).map(move |x| (x, y)));
+        let (mut known_cells, mut occupied_cells) = (0usize, 0usize);
         let (mut near, mut near_wide) = (0usize, 0usize);
-        for y in y0..y0 + wh {
-            for x in x0..x0 + ww {
-                let s = grid.state(x, y);
-                if s == CellState::Unknown {
-                    continue;
-                }
-                let p = DVec2::new(x as f64, y as f64);
-                known.push(p);
-                if s == CellState::Occupied {
-                    occ.push(p);
-                }
-                let d = walls.distance(x, y);
-                if d <= config.wall_tolerance_px {
-                    near += 1;
-                }
-                if d <= config.wide_tolerance_px {
-                    near_wide += 1;
-                }
+        for (x, y) in cells.clone() {
+            let s = grid.state(x, y);
+            if s == CellState::Unknown {
+                continue;
+            }
+            known_cells += 1;
+            occupied_cells += usize::from(s == CellState::Occupied);
+            let d = walls.distance(x, y);
+            near += usize::from(d <= config.wall_tolerance_px);
+            near_wide += usize::from(d <= config.wide_tolerance_px);
+        }
+        let (mut known, mut occ) = (
+            StridedPicker::new(known_cells, config.max_samples),
+            StridedPicker::new(occupied_cells, config.max_samples),
+        );
+        for (x, y) in cells {
+            let s = grid.state(x, y);
+            if s == CellState::Unknown {
+                continue;
+            }
+            let p = DVec2::new(x as f64, y as f64);
+            known.offer(p);
+            if s == CellState::Occupied {
+                occ.offer(p);
             }
         }
-        let known_cells = known.len();
         let normals = wall_normals(grid, (x0, y0, ww, wh));
         let free_sides = free_sides(grid, (x0, y0, ww, wh), &normals);
         let rate = |n: usize| {
@@ -179,9 +228,9 @@ impl<'a> PreparedMap<'a> {
         let mut prepared = Self {
             grid,
             walls,
-            wall_samples: strided(&occ, config.max_samples),
+            wall_samples: occ.picked,
             wall_sides: Vec::new(),
-            known_samples: strided(&known, config.max_samples),
+            known_samples: known.picked,
             known_cells,
             wall_base_rate,
             wide_base_rate,
@@ -510,6 +559,22 @@ pub fn verify_with_offsets(
 mod tests {
     use super::*;
     use crate::testmaps::{grown_room, room};
+
+    #[test]
+    fn the_strided_picker_picks_what_strided_does() {
+        for len in [0usize, 1, 7, 20, 21, 100, 1001] {
+            let items: Vec<DVec2> = (0..len).map(|i| DVec2::new(i as f64, 0.0)).collect();
+            for max in [1usize, 3, 20, 50, 2000] {
+                let mut picker = StridedPicker::new(len, max);
+                items.iter().for_each(|&p| picker.offer(p));
+                assert_eq!(
+                    picker.picked,
+                    strided(&items, max),
+                    "{len} items, {max} picks"
+                );
+            }
+        }
+    }
 
     #[test]
     fn free_sides_point_into_the_room() {
