@@ -74,6 +74,14 @@ pub struct EvalArgs {
     /// (default: the library's), for calibration experiments.
     #[arg(long)]
     confident_lift: Option<f64>,
+    /// Override what the rotation sweep charges for a wall of B on free space of A (default:
+    /// the library's), for calibration experiments.
+    #[arg(long)]
+    sweep_free_penalty: Option<f32>,
+    /// Override the same charge for the Hough search and the symmetry probes (default: the
+    /// library's), for calibration experiments.
+    #[arg(long)]
+    global_free_penalty: Option<f32>,
     /// Skip the polish of a clean best answer (to measure what it adds).
     #[arg(long)]
     no_polish: bool,
@@ -294,6 +302,12 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
         if let Some(l) = args.confident_lift {
             sweep.confident_wall_lift = l;
         }
+        if let Some(p) = args.sweep_free_penalty {
+            sweep.free_penalty = p;
+        }
+    }
+    if let (Some(p), Some(global)) = (args.global_free_penalty, config.pair.global.as_mut()) {
+        global.free_penalty = p;
     }
     if args.no_polish {
         config.pair.polish = None;
