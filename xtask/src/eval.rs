@@ -230,6 +230,28 @@ fn rows(suites: &[String], size: usize) -> Result<Vec<Row>> {
             });
         }
     }
+    if want("zero") {
+        // Zero overlap under strong equal noise, where little but speckle is left of the walls
+        // (the noise suite's 30 % and 50 % rows). Listed last, so that adding these rows left
+        // every other row's cases as they were: a row's cases are drawn from its index.
+        for noise in [0.3, 0.5] {
+            let mut config = case(
+                world(WorldKind::Disaster, size),
+                vec![lidar(noise), lidar(noise)],
+                0.0,
+            );
+            config.overlap_tolerance = 0.02;
+            rows.push(Row {
+                suite: "zero",
+                label: format!(
+                    "disaster, overlap 0 (must decline), noise {0:.0}%/{0:.0}%",
+                    noise * 100.0
+                ),
+                config,
+                expect_decline: true,
+            });
+        }
+    }
     anyhow::ensure!(!rows.is_empty(), "no known suite in {suites:?}");
     Ok(rows)
 }
