@@ -152,6 +152,11 @@ impl NearestOccupied {
         })
     }
 
+    /// The distances of the window's cells, row by row (the layout of [`Self::window`]).
+    pub(crate) fn distances(&self) -> &[f32] {
+        &self.distance
+    }
+
     /// Distance from cell `(x, y)` to the nearest occupied cell (infinite when none, and
     /// outside the known window).
     #[inline]

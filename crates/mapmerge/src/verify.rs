@@ -185,34 +185,48 @@ impl<'a> PreparedMap<'a> {
         // Everything outside the known window is unknown.
         let (x0, y0, ww, wh) = walls.window();
         // Count first, then pick the samples: the known cells of a big map run into millions,
-        // and only `max_samples` of them are kept.
-        let cells = (y0..y0 + wh).flat_map(|y| (x0..x0 + ww).map(move |x| (x, y)));
+        // and only `max_samples` of them are kept. Rows of the window are read as slices of
+        // the grid's cells and of the distances, in the same order.
+        let (gw, all_cells, all_dist) = (grid.width(), grid.cells(), walls.distances());
+        let rows = || {
+            (0..wh).map(move |j| {
+                let y = y0 + j;
+                (
+                    y,
+                    &all_cells[y * gw + x0..][..ww],
+                    &all_dist[j * ww..][..ww],
+                )
+            })
+        };
         let (mut known_cells, mut occupied_cells) = (0usize, 0usize);
         let (mut near, mut near_wide) = (0usize, 0usize);
-        for (x, y) in cells.clone() {
-            let s = grid.state(x, y);
-            if s == CellState::Unknown {
-                continue;
+        for (_, cells, dist) in rows() {
+            for (&c, &d) in cells.iter().zip(dist) {
+                let s = OccupancyGrid::classify(c);
+                if s == CellState::Unknown {
+                    continue;
+                }
+                known_cells += 1;
+                occupied_cells += usize::from(s == CellState::Occupied);
+                near += usize::from(d <= config.wall_tolerance_px);
+                near_wide += usize::from(d <= config.wide_tolerance_px);
             }
-            known_cells += 1;
-            occupied_cells += usize::from(s == CellState::Occupied);
-            let d = walls.distance(x, y);
-            near += usize::from(d <= config.wall_tolerance_px);
-            near_wide += usize::from(d <= config.wide_tolerance_px);
         }
         let (mut known, mut occ) = (
             StridedPicker::new(known_cells, config.max_samples),
             StridedPicker::new(occupied_cells, config.max_samples),
         );
-        for (x, y) in cells {
-            let s = grid.state(x, y);
-            if s == CellState::Unknown {
-                continue;
-            }
-            let p = DVec2::new(x as f64, y as f64);
-            known.offer(p);
-            if s == CellState::Occupied {
-                occ.offer(p);
+        for (y, cells, _) in rows() {
+            for (i, &c) in cells.iter().enumerate() {
+                let s = OccupancyGrid::classify(c);
+                if s == CellState::Unknown {
+                    continue;
+                }
+                let p = DVec2::new((x0 + i) as f64, y as f64);
+                known.offer(p);
+                if s == CellState::Occupied {
+                    occ.offer(p);
+                }
             }
         }
         let normals = wall_normals(grid, (x0, y0, ww, wh));
