@@ -126,20 +126,17 @@ pub struct PreparedMap<'a> {
     pub free_sides: Vec<i8>,
 }
 
-/// At most `max` of `points`, evenly strided (deterministic).
+/// At most `max` of `points`, evenly strided (deterministic): all of them when there are at
+/// most `max`, else those at indices `floor(k * len / max)` for `k` in `0..max`.
 pub(crate) fn strided<T: Copy>(points: &[T], max: usize) -> Vec<T> {
-    if points.len() <= max {
-        return points.to_vec();
-    }
-    let step = points.len() as f64 / max as f64;
-    (0..max)
-        .map(|i| points[(i as f64 * step) as usize])
-        .collect()
+    let mut picker = StridedPicker::new(points.len(), max);
+    points.iter().for_each(|&p| picker.offer(p));
+    picker.picked
 }
 
-/// [`strided`] over a sequence seen one item at a time, without storing it: offered the `len`
-/// items in order, it keeps exactly those `strided` would pick.
-struct StridedPicker {
+/// [`strided`] over a sequence seen one item at a time, without storing it: told the length
+/// `len` first and then offered the items in order, it keeps those `strided` keeps.
+struct StridedPicker<T> {
     /// Items offered so far.
     seen: usize,
     /// Picks made so far.
@@ -147,10 +144,10 @@ struct StridedPicker {
     /// The number of picks to make, and the item index of pick `k` is `floor(k * step)`.
     max: usize,
     step: f64,
-    picked: Vec<DVec2>,
+    picked: Vec<T>,
 }
 
-impl StridedPicker {
+impl<T: Copy> StridedPicker<T> {
     fn new(len: usize, max: usize) -> Self {
         let max = len.min(max);
         let step = if max == 0 {
@@ -168,8 +165,8 @@ impl StridedPicker {
     }
 
     #[inline]
-    fn offer(&mut self, p: DVec2) {
-        // With at most `max` items the step is 1 and every item is picked, as `strided` does.
+    fn offer(&mut self, p: T) {
+        // With at most `max` items the step is 1 and every item is picked.
         if self.made < self.max && self.seen == (self.made as f64 * self.step) as usize {
             self.picked.push(p);
             self.made += 1;
@@ -575,19 +572,22 @@ mod tests {
     use crate::testmaps::{grown_room, room};
 
     #[test]
-    fn the_strided_picker_picks_what_strided_does() {
-        for len in [0usize, 1, 7, 20, 21, 100, 1001] {
-            let items: Vec<DVec2> = (0..len).map(|i| DVec2::new(i as f64, 0.0)).collect();
-            for max in [1usize, 3, 20, 50, 2000] {
-                let mut picker = StridedPicker::new(len, max);
-                items.iter().for_each(|&p| picker.offer(p));
-                assert_eq!(
-                    picker.picked,
-                    strided(&items, max),
-                    "{len} items, {max} picks"
-                );
-            }
-        }
+    fn strided_keeps_evenly_spaced_items() {
+        let items: Vec<usize> = (0..10).collect();
+        assert_eq!(strided(&items, 4), vec![0, 2, 5, 7]);
+        assert_eq!(strided(&items, 3), vec![0, 3, 6]);
+        assert_eq!(strided(&items, 1), vec![0]);
+        assert_eq!(strided(&items, 10), items);
+        assert_eq!(strided(&items, 50), items);
+        assert!(strided(&items, 0).is_empty());
+        assert!(strided::<usize>(&[], 5).is_empty());
+        // The index formula, for a length that does not divide evenly.
+        let many: Vec<usize> = (0..1001).collect();
+        let picked = strided(&many, 20);
+        let want: Vec<usize> = (0..20)
+            .map(|k| (k as f64 * 1001.0 / 20.0) as usize)
+            .collect();
+        assert_eq!(picked, want);
     }
 
     #[test]
