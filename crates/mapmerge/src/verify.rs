@@ -126,12 +126,27 @@ pub struct PreparedMap<'a> {
     pub free_sides: Vec<i8>,
 }
 
+/// How [`strided`] picks `max` of `len` items: how many it keeps, and the step such that pick
+/// `k` is item `floor(k * step)`.
+fn stride(len: usize, max: usize) -> (usize, f64) {
+    let max = len.min(max);
+    (
+        max,
+        if max == 0 {
+            1.0
+        } else {
+            len as f64 / max as f64
+        },
+    )
+}
+
 /// At most `max` of `points`, evenly strided (deterministic): all of them when there are at
 /// most `max`, else those at indices `floor(k * len / max)` for `k` in `0..max`.
 pub(crate) fn strided<T: Copy>(points: &[T], max: usize) -> Vec<T> {
-    let mut picker = StridedPicker::new(points.len(), max);
-    points.iter().for_each(|&p| picker.offer(p));
-    picker.picked
+    let (max, step) = stride(points.len(), max);
+    (0..max)
+        .map(|k| points[(k as f64 * step) as usize])
+        .collect()
 }
 
 /// [`strided`] over a sequence seen one item at a time, without storing it: told the length
@@ -139,9 +154,8 @@ pub(crate) fn strided<T: Copy>(points: &[T], max: usize) -> Vec<T> {
 struct StridedPicker<T> {
     /// Items offered so far.
     seen: usize,
-    /// Picks made so far.
+    /// Picks made so far, of `max`; pick `k` is item `floor(k * step)` (see [`stride`]).
     made: usize,
-    /// The number of picks to make, and the item index of pick `k` is `floor(k * step)`.
     max: usize,
     step: f64,
     picked: Vec<T>,
@@ -149,12 +163,7 @@ struct StridedPicker<T> {
 
 impl<T: Copy> StridedPicker<T> {
     fn new(len: usize, max: usize) -> Self {
-        let max = len.min(max);
-        let step = if max == 0 {
-            1.0
-        } else {
-            len as f64 / max as f64
-        };
+        let (max, step) = stride(len, max);
         Self {
             seen: 0,
             made: 0,
@@ -166,7 +175,6 @@ impl<T: Copy> StridedPicker<T> {
 
     #[inline]
     fn offer(&mut self, p: T) {
-        // With at most `max` items the step is 1 and every item is picked.
         if self.made < self.max && self.seen == (self.made as f64 * self.step) as usize {
             self.picked.push(p);
             self.made += 1;
