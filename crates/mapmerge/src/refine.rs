@@ -291,8 +291,14 @@ pub fn refine_with_bias(
             break;
         };
         let [db, da] = bias_step.unwrap_or([0.0, 0.0]);
-        off_b = (off_b + db).clamp(0.0, MAX_OFFSET_PX);
-        off_a = (off_a + da).clamp(0.0, MAX_OFFSET_PX);
+        // The offsets as moved, within their bounds: a step that would push an offset held
+        // at a bound (both below 0, say) moves nothing, and must not keep the loop going.
+        let (new_b, new_a) = (
+            (off_b + db).clamp(0.0, MAX_OFFSET_PX),
+            (off_a + da).clamp(0.0, MAX_OFFSET_PX),
+        );
+        let moved = (new_b - off_b).abs().max((new_a - off_a).abs());
+        (off_b, off_a) = (new_b, new_a);
         // Apply the increment: rotate about c by dθ, then shift by d.
         let step = Rigid2::new(dt, 0.0, 0.0);
         let about_c = Rigid2 {
@@ -301,7 +307,7 @@ pub fn refine_with_bias(
             ty: c.y - step.apply(c).y + dy,
         };
         t = about_c.compose(&t);
-        if dt.abs() < 1e-5 && dx.hypot(dy) < 1e-3 && db.abs().max(da.abs()) < 1e-3 && f >= 1.0 {
+        if dt.abs() < 1e-5 && dx.hypot(dy) < 1e-3 && moved < 1e-3 && f >= 1.0 {
             break;
         }
     }
