@@ -58,6 +58,10 @@ pub struct EvalArgs {
     /// calibration experiments.
     #[arg(long)]
     sift_ratio: Option<f32>,
+    /// Override SIFT's grey values of free, occupied and unknown cells (default: the
+    /// library's, `1,0,0`), e.g. `1,0,0.5`, for calibration experiments.
+    #[arg(long, value_parser = grey_values)]
+    sift_mapping: Option<[f32; 3]>,
     /// Override how many distinct RANSAC hypotheses are refined and verified (default: the
     /// library's), for calibration experiments.
     #[arg(long)]
@@ -92,6 +96,20 @@ pub struct EvalArgs {
     /// Only the rows whose label contains this text (e.g. `"overlap 0.3"`).
     #[arg(long)]
     only: Option<String>,
+}
+
+/// Three grey values in `[0, 1]`, comma-separated (`--sift-mapping`).
+fn grey_values(s: &str) -> Result<[f32; 3], String> {
+    let v: Vec<f32> = s
+        .split(',')
+        .map(|x| x.trim().parse::<f32>().map_err(|e| format!("{x:?}: {e}")))
+        .collect::<Result<_, _>>()?;
+    match v.as_slice() {
+        &[f, o, u] if v.iter().all(|g| (0.0..=1.0).contains(g)) => Ok([f, o, u]),
+        _ => Err(format!(
+            "expected three grey values in [0, 1] (free,occupied,unknown), got {s:?}"
+        )),
+    }
 }
 
 /// One row of a suite: a configuration and whether success means declining.
@@ -333,6 +351,10 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
     }
     if args.no_polish {
         config.pair.polish = None;
+    }
+    if let Some([free, occupied, unknown]) = args.sift_mapping {
+        let m = &mut config.sift.mapping;
+        (m.free, m.occupied, m.unknown) = (free, occupied, unknown);
     }
     config
 }

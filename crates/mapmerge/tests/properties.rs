@@ -81,7 +81,11 @@ proptest! {
     /// others, 52 and 85 px off, RANSAC answers at wall lift 0.80-0.83, above the bar that
     /// skipped the sweep and the probes. Since the probes run up to wall lift 0.9
     /// (`PairConfig::symmetry_confident_wall_lift`, eab2248), the first failure is a sweep
-    /// answer 74 px off at wall lift 0.93: its twins were probed, and none fits as well.
+    /// answer 74 px off at wall lift 0.93: the truth turned by half a turn, B being a bare
+    /// room with a small notch. The truth fits better (wall lift 0.95) but overlaps less (61 %
+    /// of the smaller map against 83 %, so it scores 155 against 351), and the probe at its
+    /// angle refines to placements 42-57 px off that overlap more, so no rival near the truth
+    /// is found (docs/EVALUATION.md, "Tried on 2026-12-01, night").
     /// The failing cases are kept in `properties.proptest-regressions`,
     /// so `cargo test -p mapmerge --test properties -- --ignored` shows them first.
     #[test]
