@@ -573,3 +573,22 @@ pub fn run(args: EvalArgs) -> Result<()> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::grey_values;
+
+    #[test]
+    fn grey_values_take_three_greys_in_the_unit_interval() {
+        assert_eq!(grey_values("1,0,0.5"), Ok([1.0, 0.0, 0.5]));
+        assert_eq!(grey_values(" 1, 0.5 ,0"), Ok([1.0, 0.5, 0.0]));
+        let want = "expected three grey values in [0, 1] (free,occupied,unknown), got \"1,0\"";
+        assert_eq!(grey_values("1,0"), Err(want.to_string()));
+        assert!(grey_values("1,0,2").is_err());
+        assert!(grey_values("1,0,NaN").is_err());
+        assert_eq!(
+            grey_values("1,x,0"),
+            Err("\"x\": invalid float literal".to_string())
+        );
+    }
+}
