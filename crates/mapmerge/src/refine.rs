@@ -349,6 +349,35 @@ mod tests {
     }
 
     #[test]
+    fn a_converged_refinement_stops_even_with_an_offset_held_at_zero() {
+        // B is the room turned by 30 degrees and resampled cell by cell: the turned walls
+        // come out thicker on one side, so the bias fit would move both maps' walls towards
+        // their observers, below 0, where the offsets are held. Once the pose has settled,
+        // allowing one more iteration (the gate schedule, which shrinks over
+        // `max_iterations / 2`, is the same) must change nothing, bit for bit: the loop has
+        // stopped. (Before, the held offsets' steps kept it running to `max_iterations`.)
+        let a = room();
+        let a_to_b = Rigid2::new(30f64.to_radians(), 60.0, 10.0);
+        let b = a.warp(&a_to_b, 200, 200).unwrap();
+        let vc = VerifyConfig::default();
+        let (pa, pb) = (PreparedMap::new(&a, &vc), PreparedMap::new(&b, &vc));
+        let truth = a_to_b.inverse();
+        let start = Rigid2::new(truth.theta + 0.01, truth.tx + 1.0, truth.ty - 1.0);
+        let run = |max_iterations| {
+            let config = RefineConfig {
+                max_iterations,
+                ..RefineConfig::default()
+            };
+            refine_with_bias(&pa, &pb, &start, &config)
+        };
+        let (t, offsets) = run(30);
+        assert_eq!(offsets, [0.0, 0.0]);
+        let err = displacement_error(&b, &t, &truth).unwrap();
+        assert!(err < 0.5, "{err} px off");
+        assert_eq!(run(31), (t, offsets));
+    }
+
+    #[test]
     fn a_map_whose_walls_sit_behind_the_faces_gets_its_offset() {
         // B is the room with its outer walls 2 cells further out; the truth is the identity.
         let (a, b) = (room(), grown_room(2));
