@@ -89,6 +89,10 @@ pub struct EvalArgs {
     /// Skip the polish of a clean best answer (to measure what it adds).
     #[arg(long)]
     no_polish: bool,
+    /// Keep the best answer's angle from ICP instead of the walls' Hough spectra (to measure
+    /// what `mapmerge::SpectrumRotation` adds).
+    #[arg(long)]
+    no_spectrum_rotation: bool,
     /// Override the refinement's range-bias prior weight (`0` or less turns the model off;
     /// default: the library's), to measure what it adds.
     #[arg(long)]
@@ -351,6 +355,9 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
     }
     if args.no_polish {
         config.pair.polish = None;
+    }
+    if args.no_spectrum_rotation {
+        config.pair.spectrum_rotation = None;
     }
     if let Some([free, occupied, unknown]) = args.sift_mapping {
         let m = &mut config.sift.mapping;

@@ -17,5 +17,5 @@ mod testmaps;
 
 pub use register::{
     Candidate, KindTotals, Method, Origin, PairConfig, PolishConfig, RegisterConfig, Registration,
-    Timings, register, register_with,
+    SpectrumRotation, Timings, register, register_with,
 };

@@ -58,6 +58,9 @@ pub struct RefineConfig {
     /// indoor, no offsets) to 1.33 / 1.27 with W = 10 and 1.37 / 1.22 with W = 1, while
     /// W = 100 held the offsets back (1.47 / 1.15, and no more pairs registered).
     pub range_bias: Option<f64>,
+    /// Keep the rotation fixed and refine the translation (and the offsets) only. Default
+    /// false.
+    pub lock_rotation: bool,
 }
 
 impl Default for RefineConfig {
@@ -70,6 +73,7 @@ impl Default for RefineConfig {
             max_shift_px: 8.0,
             max_points: 6000,
             range_bias: Some(10.0),
+            lock_rotation: false,
         }
     }
 }
@@ -287,7 +291,13 @@ pub fn refine_with_bias(
             }
             Some([db, da])
         });
-        let Some([dt, dx, dy]) = solve(m, v) else {
+        let step = if config.lock_rotation {
+            solve([[m[1][1], m[1][2]], [m[2][1], m[2][2]]], [v[1], v[2]])
+                .map(|[dx, dy]| [0.0, dx, dy])
+        } else {
+            solve(m, v)
+        };
+        let Some([dt, dx, dy]) = step else {
             break;
         };
         let [db, da] = bias_step.unwrap_or([0.0, 0.0]);
