@@ -86,6 +86,10 @@ pub struct EvalArgs {
     /// library's), for calibration experiments.
     #[arg(long)]
     global_free_penalty: Option<f32>,
+    /// Rank the rotation sweep's placements by their normalised correlation (see
+    /// `mapmerge::global::SweepConfig::normalized`; default: the library's), to measure it.
+    #[arg(long)]
+    sweep_normalized: Option<bool>,
     /// Skip the polish of a clean best answer (to measure what it adds).
     #[arg(long)]
     no_polish: bool,
@@ -348,6 +352,9 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
         }
         if let Some(p) = args.sweep_free_penalty {
             sweep.free_penalty = p;
+        }
+        if let Some(n) = args.sweep_normalized {
+            sweep.normalized = n;
         }
     }
     if let (Some(p), Some(global)) = (args.global_free_penalty, config.pair.global.as_mut()) {

@@ -179,8 +179,12 @@ struct CoarseField {
     /// Side lengths of the (zero-padded) correlation images.
     nw: usize,
     nh: usize,
-    /// Fourier transform of A's coarse field.
+    /// Fourier transform of A's coarse field; for a normalised correlation, plus `i` times
+    /// that of A's coarse known mask (see [`CoarseField::correlate`]).
     spectrum: Vec<Complex32>,
+    /// For a normalised correlation: the mean and standard deviation of A's field over its
+    /// known coarse cells (what a wall of B landing on a random known cell of A scores).
+    normalization: Option<(f32, f32)>,
 }
 
 impl CoarseField {
@@ -191,6 +195,7 @@ impl CoarseField {
         b: &PreparedMap,
         coarse_size: usize,
         free_penalty: f32,
+        normalized: bool,
         planner: &mut FftPlanner<f32>,
     ) -> Self {
         let (wa, ha) = (a.grid.width() as f64, a.grid.height() as f64);
@@ -206,18 +211,35 @@ impl CoarseField {
             (ch + bside).next_power_of_two(),
         );
         let field = coarse_field(a, scale, cw, ch, free_penalty);
+        // Known coarse cells: those the field gives a value (walls, their spread, free space).
+        let known = |v: f32| v != 0.0;
         let mut spectrum = vec![Complex32::default(); nw * nh];
         for y in 0..ch {
             for x in 0..cw {
-                spectrum[y * nw + x].re = field[y * cw + x];
+                let v = field[y * cw + x];
+                spectrum[y * nw + x] =
+                    Complex32::new(v, if normalized && known(v) { 1.0 } else { 0.0 });
             }
         }
+        // Both transforms at once: F_A + i K_A, two real images.
         fft2(&mut spectrum, nw, nh, planner, false);
+        let normalization = normalized.then(|| {
+            let vals: Vec<f64> = field
+                .iter()
+                .filter(|v| known(**v))
+                .map(|&v| v as f64)
+                .collect();
+            let n = vals.len().max(1) as f64;
+            let mean = vals.iter().sum::<f64>() / n;
+            let var = vals.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n;
+            (mean as f32, var.sqrt().max(1e-6) as f32)
+        });
         Self {
             scale,
             nw,
             nh,
             spectrum,
+            normalization,
         }
     }
 
@@ -241,11 +263,13 @@ impl CoarseField {
             .fold(DVec2::splat(f64::INFINITY), DVec2::min);
         buf.clear();
         buf.resize(nw * nh, Complex32::default());
+        let mut cells = 0usize;
         for p in &q {
             let u = (*p - qmin) / scale;
             let (ux, uy) = (u.x.round() as usize, u.y.round() as usize);
-            if ux < nw && uy < nh {
+            if ux < nw && uy < nh && buf[uy * nw + ux].re == 0.0 {
                 buf[uy * nw + ux].re = 1.0;
+                cells += 1;
             }
         }
         fft2(buf, nw, nh, planner, false);
@@ -253,6 +277,24 @@ impl CoarseField {
             *x = y * x.conj();
         }
         fft2(buf, nw, nh, planner, true);
+        if let Some((mean, sd)) = self.normalization {
+            // The real part is C(t), the imaginary part N(t): how many of B's wall cells land
+            // on known cells of A (both scaled by the image size, the inverse FFT being
+            // unnormalised). A random placement scores about `mean * N` with a spread of
+            // `sd * sqrt(N)`; rank by how far above that a placement is, so that a larger
+            // overlap does not win by its size alone. Placements with fewer than a tenth of B's
+            // wall cells on known cells of A are not considered.
+            let size = (nw * nh) as f32;
+            let min_cells = (0.1 * cells as f32).max(5.0);
+            for z in buf.iter_mut() {
+                let (c, n) = (z.re / size, z.im / size);
+                z.re = if n >= min_cells {
+                    (c - mean * n) / (sd * n.sqrt())
+                } else {
+                    0.0
+                };
+            }
+        }
         // Negative shifts are wrapped around.
         let mut found: Vec<(f32, usize, usize)> = Vec::new();
         for ty in 0..nh {
@@ -346,7 +388,14 @@ pub fn global_hypotheses(
         angles.push(base + PI);
     }
     let mut planner = FftPlanner::<f32>::new();
-    let field = CoarseField::new(a, b, config.coarse_size, config.free_penalty, &mut planner);
+    let field = CoarseField::new(
+        a,
+        b,
+        config.coarse_size,
+        config.free_penalty,
+        false,
+        &mut planner,
+    );
     let mut buf = Vec::new();
     for theta in angles {
         let found = field.correlate(&pb, theta, config.translation_peaks, &mut planner, &mut buf);
@@ -378,6 +427,7 @@ pub fn twins(
         b,
         config.coarse_size,
         config.free_penalty,
+        false,
         &mut FftPlanner::new(),
     );
     // The first turn is none: the other translation peaks of the placement's own angle are
@@ -433,6 +483,16 @@ pub struct SweepConfig {
     /// --sweep-free-penalty 1` registers no more pairs (two fewer over all rows; `--seed 3`'s
     /// 30 % rows: three more), so the default stays.
     pub free_penalty: f32,
+    /// Rank placements by how far their correlation lies above what a random placement with
+    /// as much of B's walls on known cells of A would reach, in standard deviations, instead of
+    /// by the correlation itself (see `CoarseField::correlate`): the `keep` best of that
+    /// ranking are proposed besides the `keep` best by the plain correlation (those distinct
+    /// from them). Default true: the plain correlation grows with how much of B lands on A's
+    /// known area, so large wrong overlaps outrank a small true one. On `cargo xtask eval
+    /// --suites overlap,zero,paper,real,noise --cases 20 --seed 7` (with the spectrum angle)
+    /// disaster 0.3 rose from 35 to 40 %, indoor 0.3 from 90 to 95 %, wpi 10 -> 15 %, uos
+    /// 15 -> 25 %, intel 50 -> 65 %, no row fell, and every zero-overlap pair was declined.
+    pub normalized: bool,
 }
 
 impl Default for SweepConfig {
@@ -445,6 +505,7 @@ impl Default for SweepConfig {
             distinct_px: 12.0,
             confident_wall_lift: 0.8,
             free_penalty: 0.5,
+            normalized: true,
         }
     }
 }
@@ -474,41 +535,56 @@ pub fn sweep_hypotheses(
     {
         return;
     }
-    let field = CoarseField::new(
-        a,
-        b,
-        config.coarse_size,
-        config.free_penalty,
-        &mut FftPlanner::new(),
-    );
-    let steps = (360.0 / config.step_deg).round().max(1.0) as usize;
-    let found: Vec<(f32, Rigid2)> = (0..steps)
-        .into_par_iter()
-        .map_init(
-            || (FftPlanner::<f32>::new(), Vec::new()),
-            |(planner, buf), k| {
-                let theta = (k as f64 * 2.0 * PI / steps as f64) - PI;
-                field.correlate(&pb, theta, 1, planner, buf)
-            },
-        )
-        .flatten_iter()
-        .collect();
     let centre = pb.iter().copied().sum::<DVec2>() / pb.len() as f64;
-    let mut order: Vec<usize> = (0..found.len()).collect();
-    // Stable: ties keep angle order.
-    order.sort_by(|&i, &j| found[j].0.total_cmp(&found[i].0));
-    let mut kept: Vec<Rigid2> = Vec::new();
-    for i in order {
-        if kept.len() >= config.keep {
-            break;
-        }
-        let t = found[i].1;
-        let distinct = kept.iter().all(|k| {
+    let distinct = |kept: &[Rigid2], t: &Rigid2| {
+        kept.iter().all(|k| {
             grid_core::wrap_angle(k.theta - t.theta).abs() > 2.0 * config.step_deg.to_radians()
                 || (k.apply(centre) - t.apply(centre)).length() > config.distinct_px
-        });
-        if distinct {
-            kept.push(t);
+        })
+    };
+    let steps = (360.0 / config.step_deg).round().max(1.0) as usize;
+    // The `keep` best distinct placements of one correlation over all angles.
+    let best = |normalized: bool| {
+        let field = CoarseField::new(
+            a,
+            b,
+            config.coarse_size,
+            config.free_penalty,
+            normalized,
+            &mut FftPlanner::new(),
+        );
+        let found: Vec<(f32, Rigid2)> = (0..steps)
+            .into_par_iter()
+            .map_init(
+                || (FftPlanner::<f32>::new(), Vec::new()),
+                |(planner, buf), k| {
+                    let theta = (k as f64 * 2.0 * PI / steps as f64) - PI;
+                    field.correlate(&pb, theta, 1, planner, buf)
+                },
+            )
+            .flatten_iter()
+            .collect();
+        let mut order: Vec<usize> = (0..found.len()).collect();
+        // Stable: ties keep angle order.
+        order.sort_by(|&i, &j| found[j].0.total_cmp(&found[i].0));
+        let mut kept: Vec<Rigid2> = Vec::new();
+        for i in order {
+            if kept.len() >= config.keep {
+                break;
+            }
+            if distinct(&kept, &found[i].1) {
+                kept.push(found[i].1);
+            }
+        }
+        kept
+    };
+    let mut kept = best(false);
+    if config.normalized {
+        // Then the normalised correlation's best, those distinct from the plain ones.
+        for t in best(true) {
+            if distinct(&kept, &t) {
+                kept.push(t);
+            }
         }
     }
     out.extend(kept);
