@@ -100,8 +100,16 @@ fn rotation_candidates(sa: &[f64], sb: &[f64], peaks: usize) -> Vec<f64> {
 }
 
 /// Coarse likelihood field of A: 1 on walls (0.5 next to them), `-free_penalty` on free space,
-/// zero where unknown.
-fn coarse_field(a: &PreparedMap, scale: f64, w: usize, h: usize, free_penalty: f32) -> Vec<f32> {
+/// zero where unknown; and A's coarse known mask: cells holding a wall or free pixel, or next
+/// to a wall. The mask comes from the pixel counts, not from the field's value, so that it is
+/// right whatever `free_penalty` is (at 0 free space would otherwise look unknown).
+fn coarse_field(
+    a: &PreparedMap,
+    scale: f64,
+    w: usize,
+    h: usize,
+    free_penalty: f32,
+) -> (Vec<f32>, Vec<bool>) {
     let mut occ = vec![0u32; w * h];
     let mut free = vec![0u32; w * h];
     let g = a.grid;
@@ -128,22 +136,24 @@ fn coarse_field(a: &PreparedMap, scale: f64, w: usize, h: usize, free_penalty: f
             0.0
         };
     }
+    let mut known: Vec<bool> = (0..w * h).map(|i| occ[i] > 0 || free[i] > 0).collect();
     // Spread walls by one coarse cell so a wall off by a fraction of a cell still scores.
     let mut spread = field.clone();
     for y in 0..h {
         for x in 0..w {
-            if field[y * w + x] == 1.0 {
+            if occ[y * w + x] > 0 {
                 for (dx, dy) in [(-1i64, 0i64), (1, 0), (0, -1), (0, 1)] {
                     let (nx, ny) = (x as i64 + dx, y as i64 + dy);
                     if nx >= 0 && ny >= 0 && (nx as usize) < w && (ny as usize) < h {
-                        let s = &mut spread[ny as usize * w + nx as usize];
-                        *s = s.max(0.5);
+                        let i = ny as usize * w + nx as usize;
+                        spread[i] = spread[i].max(0.5);
+                        known[i] = true;
                     }
                 }
             }
         }
     }
-    spread
+    (spread, known)
 }
 
 fn fft2(data: &mut [Complex32], w: usize, h: usize, planner: &mut FftPlanner<f32>, inverse: bool) {
@@ -210,15 +220,13 @@ impl CoarseField {
             (cw + bside).next_power_of_two(),
             (ch + bside).next_power_of_two(),
         );
-        let field = coarse_field(a, scale, cw, ch, free_penalty);
-        // Known coarse cells: those the field gives a value (walls, their spread, free space).
-        let known = |v: f32| v != 0.0;
+        let (field, known) = coarse_field(a, scale, cw, ch, free_penalty);
         let mut spectrum = vec![Complex32::default(); nw * nh];
         for y in 0..ch {
             for x in 0..cw {
-                let v = field[y * cw + x];
-                spectrum[y * nw + x] =
-                    Complex32::new(v, if normalized && known(v) { 1.0 } else { 0.0 });
+                let i = y * cw + x;
+                let k = if normalized && known[i] { 1.0 } else { 0.0 };
+                spectrum[y * nw + x] = Complex32::new(field[i], k);
             }
         }
         // Both transforms at once: F_A + i K_A, two real images.
@@ -226,8 +234,9 @@ impl CoarseField {
         let normalization = normalized.then(|| {
             let vals: Vec<f64> = field
                 .iter()
-                .filter(|v| known(**v))
-                .map(|&v| v as f64)
+                .zip(&known)
+                .filter(|(_, k)| **k)
+                .map(|(&v, _)| v as f64)
                 .collect();
             let n = vals.len().max(1) as f64;
             let mean = vals.iter().sum::<f64>() / n;
@@ -633,6 +642,30 @@ mod tests {
             let first = grid_core::metrics::displacement_error(&b, &found[0], &truth).unwrap();
             assert!(first < 6.0, "{deg} deg: first placement {first} px off");
         }
+    }
+
+    #[test]
+    fn the_coarse_known_mask_does_not_depend_on_the_free_space_charge() {
+        let a = room();
+        let pa = PreparedMap::new(&a, &VerifyConfig::default());
+        let (w, h) = (a.width().div_ceil(3) + 1, a.height().div_ceil(3) + 1);
+        let (charged, known) = coarse_field(&pa, 3.0, w, h, 0.5);
+        let (free_of_charge, known_too) = coarse_field(&pa, 3.0, w, h, 0.0);
+        assert_eq!(known, known_too);
+        // With a charge every known cell has a value, as the field's old rule assumed ...
+        let valued = |f: &[f32]| f.iter().map(|v| *v != 0.0).collect::<Vec<_>>();
+        assert_eq!(valued(&charged), known);
+        // ... without one, free space has none and is still known.
+        let (n_known, n_valued) = (
+            known.iter().filter(|k| **k).count(),
+            valued(&free_of_charge).iter().filter(|k| **k).count(),
+        );
+        assert!(
+            n_valued < n_known / 2,
+            "{n_valued} valued of {n_known} known"
+        );
+        // Unknown cells are those with no pixel of A and no wall next to them.
+        assert!(known.iter().any(|k| !k));
     }
 
     #[test]
