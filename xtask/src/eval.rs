@@ -97,6 +97,11 @@ pub struct EvalArgs {
     /// what `mapmerge::SpectrumRotation` adds).
     #[arg(long)]
     no_spectrum_rotation: bool,
+    /// Override how far (degrees) the spectrum angle may lie from the answer's (see
+    /// `mapmerge::SpectrumRotation::max_delta_deg`; default: the library's), for calibration
+    /// experiments.
+    #[arg(long, value_parser = angle_window)]
+    spectrum_max_delta: Option<f64>,
     /// Override the refinement's range-bias prior weight (`0` or less turns the model off;
     /// default: the library's), to measure what it adds.
     #[arg(long)]
@@ -104,6 +109,18 @@ pub struct EvalArgs {
     /// Only the rows whose label contains this text (e.g. `"overlap 0.3"`).
     #[arg(long)]
     only: Option<String>,
+}
+
+/// An angle window in degrees, in `[0, 45]` (`--spectrum-max-delta`): the walls' spectrum
+/// repeats every quarter turn on a rectangular floor, so a wider window could take the next
+/// peak.
+fn angle_window(s: &str) -> Result<f64, String> {
+    let deg: f64 = s.trim().parse().map_err(|e| format!("{s:?}: {e}"))?;
+    if (0.0..=45.0).contains(&deg) {
+        Ok(deg)
+    } else {
+        Err(format!("expected degrees in [0, 45], got {s:?}"))
+    }
 }
 
 /// Three grey values in `[0, 1]`, comma-separated (`--sift-mapping`).
@@ -363,6 +380,9 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
     if args.no_polish {
         config.pair.polish = None;
     }
+    if let (Some(deg), Some(sr)) = (args.spectrum_max_delta, &mut config.pair.spectrum_rotation) {
+        sr.max_delta_deg = deg;
+    }
     if args.no_spectrum_rotation {
         config.pair.spectrum_rotation = None;
     }
@@ -590,7 +610,21 @@ pub fn run(args: EvalArgs) -> Result<()> {
 
 #[cfg(test)]
 mod tests {
-    use super::grey_values;
+    use super::{angle_window, grey_values};
+
+    #[test]
+    fn angle_windows_are_degrees_up_to_an_eighth_turn() {
+        assert_eq!(angle_window("4"), Ok(4.0));
+        assert_eq!(angle_window(" 0 "), Ok(0.0));
+        let want = "expected degrees in [0, 45], got \"NaN\"";
+        assert_eq!(angle_window("NaN"), Err(want.to_string()));
+        assert!(angle_window("-1").is_err());
+        assert!(angle_window("46").is_err());
+        assert_eq!(
+            angle_window("four"),
+            Err("\"four\": invalid float literal".to_string())
+        );
+    }
 
     #[test]
     fn grey_values_take_three_greys_in_the_unit_interval() {
