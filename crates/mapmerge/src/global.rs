@@ -182,6 +182,9 @@ fn fft2(data: &mut [Complex32], w: usize, h: usize, planner: &mut FftPlanner<f32
     }
 }
 
+/// A placement with its correlation.
+type Scored = (f32, Rigid2);
+
 /// A's coarse likelihood field, transformed, with the geometry of the correlation images.
 struct CoarseField {
     /// Coarse cell size in pixels.
@@ -254,7 +257,8 @@ impl CoarseField {
 
     /// The best `peaks` translations for B's wall points `pb` turned by `theta`: local maxima
     /// of `C(t) = sum_u F_A(u + t) P_B(u)`, as B→A transforms with their correlation, best
-    /// first. `buf` is scratch space of `nw * nh`.
+    /// first; and, for a normalised field, the best `peaks` of the normalised correlation
+    /// (empty otherwise), from the same transforms. `buf` is scratch space of `nw * nh`.
     fn correlate(
         &self,
         pb: &[DVec2],
@@ -262,7 +266,7 @@ impl CoarseField {
         peaks: usize,
         planner: &mut FftPlanner<f32>,
         buf: &mut Vec<Complex32>,
-    ) -> Vec<(f32, Rigid2)> {
+    ) -> (Vec<Scored>, Vec<Scored>) {
         let (nw, nh, scale) = (self.nw, self.nh, self.scale);
         let rot = DVec2::from_angle(theta);
         let q: Vec<DVec2> = pb.iter().map(|p| rot.rotate(*p)).collect();
@@ -286,63 +290,79 @@ impl CoarseField {
             *x = y * x.conj();
         }
         fft2(buf, nw, nh, planner, true);
-        if let Some((mean, sd)) = self.normalization {
-            // The real part is C(t), the imaginary part N(t): how many of B's wall cells land
-            // on known cells of A (both scaled by the image size, the inverse FFT being
-            // unnormalised). A random placement scores about `mean * N` with a spread of
-            // `sd * sqrt(N)`; rank by how far above that a placement is, so that a larger
-            // overlap does not win by its size alone. Placements with fewer than a tenth of B's
-            // wall cells on known cells of A are not considered.
-            let size = (nw * nh) as f32;
-            let min_cells = (0.1 * cells as f32).max(5.0);
-            for z in buf.iter_mut() {
+        // B's image is real, so the real part is C(t) and, for a normalised field, the
+        // imaginary part N(t): how many of B's wall cells land on known cells of A (both scaled
+        // by the image size, the inverse FFT being unnormalised).
+        let placement = |tx: usize, ty: usize| {
+            let wrap = |t: usize, n: usize| {
+                if t > n / 2 {
+                    t as f64 - n as f64
+                } else {
+                    t as f64
+                }
+            };
+            // Negative shifts are wrapped around.
+            let t = scale * DVec2::new(wrap(tx, nw), wrap(ty, nh)) - qmin;
+            Rigid2::new(theta, t.x, t.y).normalized()
+        };
+        let best = |score: &[f32]| {
+            local_maxima(score, nw, nh, peaks)
+                .into_iter()
+                .map(|(v, tx, ty)| (v, placement(tx, ty)))
+                .collect::<Vec<_>>()
+        };
+        let plain: Vec<f32> = buf.iter().map(|z| z.re).collect();
+        let Some((mean, sd)) = self.normalization else {
+            return (best(&plain), Vec::new());
+        };
+        // A random placement scores about `mean * N` with a spread of `sd * sqrt(N)`; the
+        // normalised ranking is by how far above that a placement is, so that a larger overlap
+        // does not win by its size alone. Placements with fewer than a tenth of B's wall cells
+        // on known cells of A are not considered.
+        let size = (nw * nh) as f32;
+        let min_cells = (0.1 * cells as f32).max(5.0);
+        let normalized: Vec<f32> = buf
+            .iter()
+            .map(|z| {
                 let (c, n) = (z.re / size, z.im / size);
-                z.re = if n >= min_cells {
+                if n >= min_cells {
                     (c - mean * n) / (sd * n.sqrt())
                 } else {
                     0.0
-                };
-            }
-        }
-        // Negative shifts are wrapped around.
-        let mut found: Vec<(f32, usize, usize)> = Vec::new();
-        for ty in 0..nh {
-            for tx in 0..nw {
-                let v = buf[ty * nw + tx].re;
-                if v <= 0.0 {
-                    continue;
                 }
-                let is_max = (-1i64..=1).all(|dy| {
-                    (-1i64..=1).all(|dx| {
-                        let (nx, ny) = (
-                            (tx as i64 + dx).rem_euclid(nw as i64),
-                            (ty as i64 + dy).rem_euclid(nh as i64),
-                        );
-                        (dx == 0 && dy == 0) || buf[ny as usize * nw + nx as usize].re <= v
-                    })
-                });
-                if is_max {
-                    found.push((v, tx, ty));
-                }
-            }
-        }
-        found.sort_by(|x, y| y.0.total_cmp(&x.0));
-        found
-            .iter()
-            .take(peaks)
-            .map(|&(v, tx, ty)| {
-                let wrap = |t: usize, n: usize| {
-                    if t > n / 2 {
-                        t as f64 - n as f64
-                    } else {
-                        t as f64
-                    }
-                };
-                let t = scale * DVec2::new(wrap(tx, nw), wrap(ty, nh)) - qmin;
-                (v, Rigid2::new(theta, t.x, t.y).normalized())
             })
-            .collect()
+            .collect();
+        (best(&plain), best(&normalized))
     }
+}
+
+/// The best `peaks` positive local maxima `(value, x, y)` of the `w x h` image `score` (its
+/// borders wrapped around), highest first.
+fn local_maxima(score: &[f32], w: usize, h: usize, peaks: usize) -> Vec<(f32, usize, usize)> {
+    let mut found: Vec<(f32, usize, usize)> = Vec::new();
+    for ty in 0..h {
+        for tx in 0..w {
+            let v = score[ty * w + tx];
+            if v <= 0.0 {
+                continue;
+            }
+            let is_max = (-1i64..=1).all(|dy| {
+                (-1i64..=1).all(|dx| {
+                    let (nx, ny) = (
+                        (tx as i64 + dx).rem_euclid(w as i64),
+                        (ty as i64 + dy).rem_euclid(h as i64),
+                    );
+                    (dx == 0 && dy == 0) || score[ny as usize * w + nx as usize] <= v
+                })
+            });
+            if is_max {
+                found.push((v, tx, ty));
+            }
+        }
+    }
+    found.sort_by(|x, y| y.0.total_cmp(&x.0));
+    found.truncate(peaks);
+    found
 }
 
 /// The rotation of B onto A (radians) that the Hough spectra of the maps' walls give nearest
@@ -407,7 +427,8 @@ pub fn global_hypotheses(
     );
     let mut buf = Vec::new();
     for theta in angles {
-        let found = field.correlate(&pb, theta, config.translation_peaks, &mut planner, &mut buf);
+        let (found, _) =
+            field.correlate(&pb, theta, config.translation_peaks, &mut planner, &mut buf);
         out.extend(found.into_iter().map(|(_, t)| t));
     }
 }
@@ -447,7 +468,9 @@ pub fn twins(
             || (FftPlanner::<f32>::new(), Vec::new()),
             |(planner, buf), &k| {
                 let theta = b_to_a.theta + k * PI;
-                field.correlate(&pb, theta, config.translation_peaks, planner, buf)
+                field
+                    .correlate(&pb, theta, config.translation_peaks, planner, buf)
+                    .0
             },
         )
         .flatten_iter()
@@ -552,27 +575,29 @@ pub fn sweep_hypotheses(
         })
     };
     let steps = (360.0 / config.step_deg).round().max(1.0) as usize;
-    // The `keep` best distinct placements of one correlation over all angles.
-    let best = |normalized: bool| {
-        let field = CoarseField::new(
-            a,
-            b,
-            config.coarse_size,
-            config.free_penalty,
-            normalized,
-            &mut FftPlanner::new(),
-        );
-        let found: Vec<(f32, Rigid2)> = (0..steps)
-            .into_par_iter()
-            .map_init(
-                || (FftPlanner::<f32>::new(), Vec::new()),
-                |(planner, buf), k| {
-                    let theta = (k as f64 * 2.0 * PI / steps as f64) - PI;
-                    field.correlate(&pb, theta, 1, planner, buf)
-                },
-            )
-            .flatten_iter()
-            .collect();
+    // One field and one pair of transforms per angle serve both rankings: with the known mask
+    // packed into the field, the plain correlation is the real part.
+    let field = CoarseField::new(
+        a,
+        b,
+        config.coarse_size,
+        config.free_penalty,
+        config.normalized,
+        &mut FftPlanner::new(),
+    );
+    let (plain, normalized): (Vec<_>, Vec<_>) = (0..steps)
+        .into_par_iter()
+        .map_init(
+            || (FftPlanner::<f32>::new(), Vec::new()),
+            |(planner, buf), k| {
+                let theta = (k as f64 * 2.0 * PI / steps as f64) - PI;
+                field.correlate(&pb, theta, 1, planner, buf)
+            },
+        )
+        .unzip();
+    // The `keep` best distinct placements of one ranking over all angles.
+    let best = |per_angle: Vec<Vec<Scored>>| {
+        let found: Vec<Scored> = per_angle.into_iter().flatten().collect();
         let mut order: Vec<usize> = (0..found.len()).collect();
         // Stable: ties keep angle order.
         order.sort_by(|&i, &j| found[j].0.total_cmp(&found[i].0));
@@ -587,13 +612,12 @@ pub fn sweep_hypotheses(
         }
         kept
     };
-    let mut kept = best(false);
-    if config.normalized {
-        // Then the normalised correlation's best, those distinct from the plain ones.
-        for t in best(true) {
-            if distinct(&kept, &t) {
-                kept.push(t);
-            }
+    let mut kept = best(plain);
+    // Then the normalised correlation's best (none when it is off), those distinct from the
+    // plain ones.
+    for t in best(normalized) {
+        if distinct(&kept, &t) {
+            kept.push(t);
         }
     }
     out.extend(kept);
