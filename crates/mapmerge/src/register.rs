@@ -114,15 +114,10 @@ fn turned_about_overlap(
     b_to_a: &Rigid2,
     theta: f64,
 ) -> Option<Rigid2> {
-    let (w, h) = (a.grid.width() as f64, a.grid.height() as f64);
     let (mut sum, mut n) = (grid_core::DVec2::ZERO, 0usize);
     for q in b.wall_samples.iter().map(|p| b_to_a.apply(*p)) {
-        let (x, y) = (q.x.round(), q.y.round());
-        if x >= 0.0
-            && y >= 0.0
-            && x < w
-            && y < h
-            && a.grid.state(x as usize, y as usize) != grid_core::CellState::Unknown
+        if crate::verify::cell_of(a.grid, q)
+            .is_some_and(|(x, y)| a.grid.state(x, y) != grid_core::CellState::Unknown)
         {
             sum += q;
             n += 1;

@@ -417,8 +417,9 @@ impl Verification {
     }
 }
 
+/// The cell of `grid` holding point `q` (pixel centres at integers), if inside it.
 #[inline]
-fn cell_of(grid: &OccupancyGrid, q: DVec2) -> Option<(usize, usize)> {
+pub(crate) fn cell_of(grid: &OccupancyGrid, q: DVec2) -> Option<(usize, usize)> {
     let (x, y) = (q.x.round(), q.y.round());
     (x >= 0.0 && y >= 0.0 && (x as usize) < grid.width() && (y as usize) < grid.height())
         .then_some((x as usize, y as usize))
