@@ -14,6 +14,7 @@ use anyhow::{Context, Result};
 use grid_core::metrics::{displacement_error, rotation_error_deg};
 use indicatif::{ProgressBar, ProgressStyle};
 use mapmerge::refine::refine;
+use mapmerge::search::SearchConfig;
 use mapmerge::verify::{PreparedMap, verify};
 use mapmerge::{Method, RegisterConfig, register};
 use mapsim::{CaseConfig, RobotConfig, WorldConfig, WorldKind, generate_case};
@@ -102,6 +103,11 @@ pub struct EvalArgs {
     /// experiments.
     #[arg(long, value_parser = angle_window)]
     spectrum_max_delta: Option<f64>,
+    /// Override the rotation window (degrees) of the whole-map placements' second local search
+    /// (see `mapmerge::PairConfig::turn_search`; `0` turns that search off; default: the
+    /// library's), to measure what it adds.
+    #[arg(long, value_parser = angle_window)]
+    turn_search: Option<f64>,
     /// Override the refinement's range-bias prior weight (`0` or less turns the model off;
     /// default: the library's), to measure what it adds.
     #[arg(long)]
@@ -379,6 +385,12 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
     }
     if args.no_polish {
         config.pair.polish = None;
+    }
+    if let Some(deg) = args.turn_search {
+        config.pair.turn_search = (deg > 0.0).then(|| SearchConfig {
+            max_angle_deg: deg,
+            ..config.pair.turn_search.unwrap_or_default()
+        });
     }
     if let (Some(deg), Some(sr)) = (args.spectrum_max_delta, &mut config.pair.spectrum_rotation) {
         sr.max_delta_deg = deg;
