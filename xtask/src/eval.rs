@@ -117,9 +117,9 @@ pub struct EvalArgs {
     only: Option<String>,
 }
 
-/// An angle window in degrees, in `[0, 45]` (`--spectrum-max-delta`): the walls' spectrum
-/// repeats every quarter turn on a rectangular floor, so a wider window could take the next
-/// peak.
+/// An angle window in degrees, in `[0, 45]` (`--spectrum-max-delta`, `--turn-search`): the
+/// walls' spectrum repeats every quarter turn on a rectangular floor, so a wider window could
+/// take the next peak, and a local search that wide is no longer local.
 fn angle_window(s: &str) -> Result<f64, String> {
     let deg: f64 = s.trim().parse().map_err(|e| format!("{s:?}: {e}"))?;
     if (0.0..=45.0).contains(&deg) {
