@@ -405,8 +405,9 @@ pub fn register_with(
     let t0 = Instant::now();
     // Each hypothesis is polished by ICP, once from itself and once from the best pose of the
     // correlative local search around it (keypoints, or the global search's coarse grid, can
-    // put it a few pixels off, outside ICP's narrow basin); the polished pose the maps agree
-    // with more wins. Global hypotheses refine with their own, wider-gated configuration.
+    // put it a few pixels off, outside ICP's narrow basin), and for whole-map placements once
+    // more from the best pose of the turn search; the polished pose the maps agree with most
+    // wins. Global hypotheses refine with their own, wider-gated configuration.
     let check = |model: &Rigid2, refine_config: &RefineConfig, origin: Origin| {
         // Whole-map placements are also searched over rotation.
         let turn_search = if origin == Origin::Ransac {
