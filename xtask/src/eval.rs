@@ -7,18 +7,21 @@
 //! zero-overlap suite, a success is a decline.
 
 use std::fmt::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{Context, Result};
 use grid_core::metrics::{displacement_error, rotation_error_deg};
+use grid_core::{DVec2, Rigid2};
 use indicatif::{ProgressBar, ProgressStyle};
 use mapmerge::refine::refine;
 use mapmerge::search::SearchConfig;
 use mapmerge::verify::{PreparedMap, verify};
 use mapmerge::{Method, RegisterConfig, register};
-use mapsim::{CaseConfig, RobotConfig, WorldConfig, WorldKind, generate_case};
+use mapsim::{Case, CaseConfig, RobotConfig, WorldConfig, WorldKind, generate_case};
 use rayon::prelude::*;
+
+use crate::picture;
 
 /// Arguments of `cargo xtask eval`.
 #[derive(Debug, clap::Args)]
@@ -115,6 +118,12 @@ pub struct EvalArgs {
     /// Only the rows whose label contains this text (e.g. `"overlap 0.3"`).
     #[arg(long)]
     only: Option<String>,
+    /// Write a picture of every case that is not a success to DIR/SEED-METHOD.png: B's walls
+    /// laid over A at the truth, then at the best candidate. Red: A's walls, blue: B's,
+    /// purple: both; yellow: obstacle cells of the world that A marks free (the range bias);
+    /// dark red and dark blue dots: the robots' paths.
+    #[arg(long, value_name = "DIR")]
+    pictures: Option<PathBuf>,
 }
 
 /// An angle window in degrees, in `[0, 45]` (`--spectrum-max-delta`, `--turn-search`): the
@@ -405,8 +414,47 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
     config
 }
 
-/// Generate case `seed` of `row` once and register it with every method.
-fn run_case(row: &Row, methods: &[Method], seed: u64, defaults: &RegisterConfig) -> Vec<Outcome> {
+/// The picture of a case that failed (see `--pictures`): the truth's panel, then the best
+/// candidate's, if there is one.
+fn write_picture(case: &Case, best: Option<&Rigid2>, path: &Path) -> Result<()> {
+    let (ra, rb) = (&case.robots[0], &case.robots[1]);
+    let a = &ra.map;
+    let obstacle = (0..a.width() * a.height())
+        .map(|i| {
+            let q = ra
+                .map_to_world
+                .apply(DVec2::new((i % a.width()) as f64, (i / a.width()) as f64))
+                .round();
+            case.world.is_occupied(q.x as i64, q.y as i64)
+        })
+        .collect();
+    let scene = picture::Scene {
+        a,
+        b: &rb.map,
+        obstacle,
+        a_path: ra.path_in_map(),
+        b_path: rb.path_in_map(),
+    };
+    let panels: Vec<_> = std::iter::once(case.truth(0, 1))
+        .chain(best.copied())
+        .map(|t| scene.panel(&t))
+        .collect();
+    let mut png = Vec::new();
+    picture::side_by_side(&panels)
+        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .with_context(|| format!("encoding {}", path.display()))?;
+    grid_core::io::write_atomic(path, &png).with_context(|| format!("writing {}", path.display()))
+}
+
+/// Generate case `seed` of `row` once and register it with every method; with `pictures`,
+/// draw each method's failure there.
+fn run_case(
+    row: &Row,
+    methods: &[Method],
+    seed: u64,
+    defaults: &RegisterConfig,
+    pictures: Option<&Path>,
+) -> Result<Vec<Outcome>> {
     let blank = |method: Method| Outcome {
         suite: row.suite,
         row: row.label.clone(),
@@ -431,13 +479,13 @@ fn run_case(row: &Row, methods: &[Method], seed: u64, defaults: &RegisterConfig)
     let case = match generate_case(&row.config, seed) {
         Ok(c) => c,
         Err(e) => {
-            return methods
+            return Ok(methods
                 .iter()
                 .map(|&m| Outcome {
                     error: Some(e.to_string()),
                     ..blank(m)
                 })
-                .collect();
+                .collect());
         }
     };
     let (a, b) = (&case.robots[0].map, &case.robots[1].map);
@@ -471,7 +519,7 @@ fn run_case(row: &Row, methods: &[Method], seed: u64, defaults: &RegisterConfig)
                 Ok(r) => r,
                 Err(e) => {
                     out.error = Some(e.to_string());
-                    return out;
+                    return Ok(out);
                 }
             };
             out.millis = t0.elapsed().as_secs_f64() * 1e3;
@@ -499,7 +547,11 @@ fn run_case(row: &Row, methods: &[Method], seed: u64, defaults: &RegisterConfig)
             } else {
                 out.displacement_error_px.is_some_and(|d| d <= 3.0)
             };
-            out
+            if let Some(dir) = pictures.filter(|_| !out.success) {
+                let best = result.candidates.first().map(|c| &c.transform);
+                write_picture(&case, best, &dir.join(format!("{seed}-{method}.png")))?;
+            }
+            Ok(out)
         })
         .collect()
 }
@@ -544,13 +596,25 @@ pub fn run(args: EvalArgs) -> Result<()> {
             .expect("static template")
             .progress_chars("=> "),
     );
+    if let Some(dir) = &args.pictures {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
     let outcomes: Vec<Outcome> = jobs
         .par_iter()
-        .flat_map_iter(|&(r, seed)| {
-            let o = run_case(&rows[r], &args.methods, seed, &defaults);
+        .map(|&(r, seed)| {
+            let o = run_case(
+                &rows[r],
+                &args.methods,
+                seed,
+                &defaults,
+                args.pictures.as_deref(),
+            );
             bar.inc(1);
             o
         })
+        .collect::<Result<Vec<_>>>()?
+        .into_iter()
+        .flatten()
         .collect();
     bar.finish_and_clear();
 

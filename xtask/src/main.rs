@@ -5,6 +5,7 @@ use clap::{Parser, Subcommand};
 
 mod eval;
 mod r#gen;
+mod picture;
 
 /// mapmerge project tasks.
 #[derive(Parser)]
