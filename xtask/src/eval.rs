@@ -124,6 +124,28 @@ pub struct EvalArgs {
     /// dark red and dark blue dots: the robots' paths.
     #[arg(long, value_name = "DIR")]
     pictures: Option<PathBuf>,
+    /// Write the selected rows' cases as map_server files instead of registering them:
+    /// DIR/SUITE-ROW/case_SEED/ holds robot_0.yaml, robot_1.yaml (A and B), truth.json and
+    /// preview.png, as `cargo xtask gen` writes them, ROW being the row's label in lower case
+    /// with `_` for other characters. A pair must be declined when truth.json's
+    /// `requested_overlap` is 0. Other tools then run on exactly the eval's cases, e.g.
+    /// `python3 tools/baselines/compare.py DIR/*` (mapmerge through its binary against the
+    /// ROS package's pipeline and OpenCV SIFT).
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["out", "pictures"])]
+    export: Option<PathBuf>,
+}
+
+/// A row label as a folder name: lower case, runs of other characters as one `_`.
+fn slug(label: &str) -> String {
+    let mut out = String::new();
+    for c in label.chars() {
+        if c.is_ascii_alphanumeric() {
+            out.push(c.to_ascii_lowercase());
+        } else if !out.ends_with('_') {
+            out.push('_');
+        }
+    }
+    out.trim_matches('_').to_string()
 }
 
 /// An angle window in degrees, in `[0, 45]` (`--spectrum-max-delta`, `--turn-search`): the
@@ -568,6 +590,43 @@ fn fmt_opt(v: Option<f64>, digits: usize) -> String {
     v.map_or("-".into(), |v| format!("{v:.digits$}"))
 }
 
+/// `--export`: generate every job's case and write it under `dir` (see [`EvalArgs::export`]).
+/// A case that cannot be generated (the zero-overlap rows' tours that cross themselves) is
+/// reported and skipped, as the eval skips it.
+fn export(rows: &[Row], jobs: &[(usize, u64)], dir: &Path, bar: &ProgressBar) -> Result<()> {
+    let skipped: Vec<String> = jobs
+        .par_iter()
+        .map(|&(r, seed)| {
+            let row = &rows[r];
+            let out = match generate_case(&row.config, seed) {
+                Ok(case) => {
+                    let folder = format!("{}-{}", row.suite, slug(&row.label));
+                    let case_dir = dir.join(folder).join(format!("case_{seed}"));
+                    crate::r#gen::write_case(&case, &row.label, &case_dir)
+                        .with_context(|| format!("writing {}", case_dir.display()))?;
+                    None
+                }
+                Err(e) => Some(format!("{} seed {seed}: {e}", row.label)),
+            };
+            bar.inc(1);
+            Ok(out)
+        })
+        .collect::<Result<Vec<_>>>()?
+        .into_iter()
+        .flatten()
+        .collect();
+    bar.finish_and_clear();
+    for s in &skipped {
+        eprintln!("not generated: {s}");
+    }
+    eprintln!(
+        "wrote {} cases under {}",
+        jobs.len() - skipped.len(),
+        dir.display()
+    );
+    Ok(())
+}
+
 /// Run `cargo xtask eval`.
 pub fn run(args: EvalArgs) -> Result<()> {
     let rows = rows(&args.suites, args.size)?;
@@ -596,6 +655,9 @@ pub fn run(args: EvalArgs) -> Result<()> {
             .expect("static template")
             .progress_chars("=> "),
     );
+    if let Some(dir) = &args.export {
+        return export(&rows, &jobs, dir, &bar);
+    }
     if let Some(dir) = &args.pictures {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
@@ -686,7 +748,80 @@ pub fn run(args: EvalArgs) -> Result<()> {
 
 #[cfg(test)]
 mod tests {
-    use super::{angle_window, grey_values};
+    use super::{Row, angle_window, export, grey_values, slug};
+    use grid_core::io::{LoadOptions, load_map};
+    use mapsim::{CaseConfig, generate_case};
+
+    #[test]
+    fn row_labels_become_folder_names() {
+        assert_eq!(
+            slug("disaster, overlap 0.5, noise 10%/10%"),
+            "disaster_overlap_0_5_noise_10_10"
+        );
+        assert_eq!(
+            slug("paper preset: 150x150, 16 IR beams, noise 10%/15%"),
+            "paper_preset_150x150_16_ir_beams_noise_10_15"
+        );
+        assert_eq!(
+            slug("indoor, overlap 0 (must decline)"),
+            "indoor_overlap_0_must_decline"
+        );
+    }
+
+    #[test]
+    fn export_writes_each_case_as_the_eval_generates_it() {
+        let mut config = CaseConfig::paper();
+        config.overlap_tolerance = f64::INFINITY;
+        let rows = [Row {
+            suite: "paper",
+            label: "paper preset".into(),
+            config: config.clone(),
+            expect_decline: false,
+        }];
+        let dir = tempfile::tempdir().unwrap();
+        let jobs = [(0, 11_000), (0, 11_001)];
+        export(&rows, &jobs, dir.path(), &indicatif::ProgressBar::hidden()).unwrap();
+        for (_, seed) in jobs {
+            let case_dir = dir.path().join(format!("paper-paper_preset/case_{seed}"));
+            let case = generate_case(&config, seed).unwrap();
+            let truth: serde_json::Value =
+                serde_json::from_slice(&std::fs::read(case_dir.join("truth.json")).unwrap())
+                    .unwrap();
+            assert_eq!(truth["preset"], "paper preset");
+            assert_eq!(truth["seed"], seed);
+            // serde_json writes the shortest exact form, but its default parser may land one
+            // unit in the last place off: compare the numbers to well below that.
+            let close = |v: &serde_json::Value, want: f64| {
+                let got = v.as_f64().unwrap();
+                assert!(
+                    (got - want).abs() <= 1e-12 * want.abs().max(1.0),
+                    "{got} vs {want}"
+                );
+            };
+            close(&truth["achieved_overlap"], case.achieved_overlap);
+            let t = case.truth(0, 1);
+            assert_eq!(truth["pairs"][0]["a"], 0);
+            assert_eq!(truth["pairs"][0]["b"], 1);
+            close(&truth["pairs"][0]["transform"]["theta"], t.theta);
+            close(&truth["pairs"][0]["transform"]["tx"], t.tx);
+            close(&truth["pairs"][0]["transform"]["ty"], t.ty);
+            for (k, robot) in case.robots.iter().enumerate() {
+                let read = load_map(
+                    case_dir.join(format!("robot_{k}.yaml")),
+                    &LoadOptions::default(),
+                )
+                .unwrap();
+                // The files hold each cell's class (map_saver's trinary values).
+                assert_eq!(read.width(), robot.map.width());
+                assert_eq!(read.height(), robot.map.height());
+                for y in 0..read.height() {
+                    for x in 0..read.width() {
+                        assert_eq!(read.state(x, y), robot.map.state(x, y), "({x}, {y})");
+                    }
+                }
+            }
+        }
+    }
 
     #[test]
     fn angle_windows_are_degrees_up_to_an_eighth_turn() {

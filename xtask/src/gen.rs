@@ -148,7 +148,7 @@ pub fn run(args: Args) -> Result<()> {
         let case =
             generate_case(&config, seed).with_context(|| format!("case {k} (seed {seed})"))?;
         let dir = args.out.join(format!("case_{k}"));
-        write_case(&case, args.preset, &dir)?;
+        write_case(&case, &format!("{:?}", args.preset).to_lowercase(), &dir)?;
         match &bar {
             Some(b) => b.inc(1),
             None => eprintln!(
@@ -166,7 +166,10 @@ pub fn run(args: Args) -> Result<()> {
     Ok(())
 }
 
-fn write_case(case: &Case, preset: Preset, dir: &Path) -> Result<()> {
+/// Write `case` into `dir` (created): each robot's map as map_saver writes it
+/// (`robot_K.yaml` and `.pgm`), `truth.json` (every pair's transform, the configuration;
+/// `preset` names where it came from) and `preview.png`.
+pub(crate) fn write_case(case: &Case, preset: &str, dir: &Path) -> Result<()> {
     fs::create_dir_all(dir).with_context(|| format!("{}", dir.display()))?;
     let world_geo = GridGeometry {
         width: case.world.width(),
@@ -205,7 +208,7 @@ fn write_case(case: &Case, preset: Preset, dir: &Path) -> Result<()> {
     };
     let truth = json!({
         "seed": case.seed,
-        "preset": format!("{preset:?}").to_lowercase(),
+        "preset": preset,
         "convention": "transform maps a pixel of map b onto map a (x column, y row from top); \
                        map_to_world maps a map pixel to a world-raster pixel; world_pose is the \
                        map frame in the world frame (metres, yaw ccw, world origin 0)",
