@@ -86,6 +86,11 @@ proptest! {
     /// of the smaller map against 83 %, so it scores 155 against 351), and the probe at its
     /// angle refines to placements 42-57 px off that overlap more, so no rival near the truth
     /// is found (docs/EVALUATION.md, "Tried on 2026-12-01, night").
+    /// On 2026-12-02 the failure proptest shrinks to (from the regressions file) is a
+    /// square room: the answer is the truth turned by half a turn (91 px off, wall lift 0.88,
+    /// contradiction 0.04, 86 % overlap) and the truth fits worse (wall lift 0.78,
+    /// contradiction 0.14, 61 % overlap), so no rule that prefers the better fit can pick it
+    /// (docs/EVALUATION.md, "Tried on 2026-12-02, 05:00-06:00 UTC").
     /// The failing cases are kept in `properties.proptest-regressions`,
     /// so `cargo test -p mapmerge --test properties -- --ignored` shows them first.
     #[test]
