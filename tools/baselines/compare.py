@@ -266,7 +266,10 @@ def main():
                       + (f"accepted, {disp:.2f} px, {rot:.2f} deg" if accepted else "declined")
                       + f" ({ms:.0f} ms)", file=sys.stderr)
     if args.out:
-        Path(args.out).write_text("".join(json.dumps(r) + "\n" for r in records))
+        # Written beside, then renamed: a reader never sees half a file.
+        tmp = Path(args.out).with_name(f".{Path(args.out).name}.tmp")
+        tmp.write_text("".join(json.dumps(r) + "\n" for r in records))
+        tmp.replace(args.out)
 
     print("| cases | method | pairs | success | accepted | false accepts "
           "| within 3 px, any confidence | median rot. err (deg) | median disp. err (px) "
