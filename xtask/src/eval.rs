@@ -14,9 +14,9 @@ use anyhow::{Context, Result};
 use grid_core::metrics::{displacement_error, rotation_error_deg};
 use grid_core::{DVec2, Rigid2};
 use indicatif::{ProgressBar, ProgressStyle};
-use mapmerge::refine::refine;
+use mapmerge::refine::refine_with_bias;
 use mapmerge::search::SearchConfig;
-use mapmerge::verify::{PreparedMap, verify};
+use mapmerge::verify::{PreparedMap, verify, verify_with_offsets};
 use mapmerge::{Method, RegisterConfig, register};
 use mapsim::{Case, CaseConfig, RobotConfig, WorldConfig, WorldKind, generate_case};
 use rayon::prelude::*;
@@ -363,6 +363,11 @@ struct Outcome {
     /// verification could reach at best.
     truth_verification: Option<mapmerge::verify::Verification>,
     truth_refined_drift_px: Option<f64>,
+    /// Scores of that refined truth, computed as a candidate's are (with the range-bias
+    /// offsets its refinement fitted, when the pipeline scores with them): compared with the
+    /// answer's, whether a wrong answer is a search failure (the refined truth scores higher)
+    /// or the objective's (it scores lower).
+    truth_refined_verification: Option<mapmerge::verify::Verification>,
     /// Correspondences that agree with the truth (within the RANSAC threshold), by kind: how
     /// much real evidence hypothesis generation had to work with.
     true_correspondences: Option<mapmerge::KindTotals>,
@@ -496,6 +501,7 @@ fn run_case(
         correspondences: None,
         truth_verification: None,
         truth_refined_drift_px: None,
+        truth_refined_verification: None,
         true_correspondences: None,
     };
     let case = match generate_case(&row.config, seed) {
@@ -514,17 +520,25 @@ fn run_case(
     let truth = case.truth(0, 1);
     // What the verification and the refinement reach at best, started at the truth; the
     // same for every method.
-    let (truth_verification, truth_refined_drift_px) = if row.expect_decline {
-        (None, None)
-    } else {
-        let vc = &defaults.pair.verify;
-        let (pa, pb) = (PreparedMap::new(a, vc), PreparedMap::new(b, vc));
-        let refined = refine(&pa, &pb, &truth, &defaults.pair.refine);
-        (
-            Some(verify(&pa, &pb, &truth, vc)),
-            displacement_error(b, &refined, &truth),
-        )
-    };
+    let (truth_verification, truth_refined_drift_px, truth_refined_verification) =
+        if row.expect_decline {
+            (None, None, None)
+        } else {
+            let vc = &defaults.pair.verify;
+            let (pa, pb) = (PreparedMap::new(a, vc), PreparedMap::new(b, vc));
+            let (refined, offsets) = refine_with_bias(&pa, &pb, &truth, &defaults.pair.refine);
+            let refined = refined.normalized();
+            let refined_scores = if defaults.pair.offsets_in_verification {
+                verify_with_offsets(&pa, &pb, &refined, offsets, vc)
+            } else {
+                verify(&pa, &pb, &refined, vc)
+            };
+            (
+                Some(verify(&pa, &pb, &truth, vc)),
+                displacement_error(b, &refined, &truth),
+                Some(refined_scores),
+            )
+        };
     methods
         .iter()
         .map(|&method| {
@@ -532,6 +546,7 @@ fn run_case(
             out.achieved_overlap = case.achieved_overlap;
             out.truth_verification = truth_verification;
             out.truth_refined_drift_px = truth_refined_drift_px;
+            out.truth_refined_verification = truth_refined_verification;
             let config = RegisterConfig {
                 method,
                 ..defaults.clone()
