@@ -14,10 +14,9 @@ use anyhow::{Context, Result};
 use grid_core::metrics::{displacement_error, rotation_error_deg};
 use grid_core::{DVec2, Rigid2};
 use indicatif::{ProgressBar, ProgressStyle};
-use mapmerge::refine::refine_with_bias;
 use mapmerge::search::SearchConfig;
-use mapmerge::verify::{PreparedMap, verify, verify_with_offsets};
-use mapmerge::{Method, RegisterConfig, register};
+use mapmerge::verify::{PreparedMap, verify};
+use mapmerge::{Method, RegisterConfig, refine_and_score, register};
 use mapsim::{Case, CaseConfig, RobotConfig, WorldConfig, WorldKind, generate_case};
 use rayon::prelude::*;
 
@@ -526,13 +525,8 @@ fn run_case(
         } else {
             let vc = &defaults.pair.verify;
             let (pa, pb) = (PreparedMap::new(a, vc), PreparedMap::new(b, vc));
-            let (refined, offsets) = refine_with_bias(&pa, &pb, &truth, &defaults.pair.refine);
-            let refined = refined.normalized();
-            let refined_scores = if defaults.pair.offsets_in_verification {
-                verify_with_offsets(&pa, &pb, &refined, offsets, vc)
-            } else {
-                verify(&pa, &pb, &refined, vc)
-            };
+            let (refined, refined_scores) =
+                refine_and_score(&pa, &pb, &truth, &defaults.pair.refine, &defaults.pair);
             (
                 Some(verify(&pa, &pb, &truth, vc)),
                 displacement_error(b, &refined, &truth),

@@ -346,6 +346,27 @@ fn ms(t: Instant) -> f64 {
     t.elapsed().as_secs_f64() * 1e3
 }
 
+/// A pose as every hypothesis is polished and scored: refined from `start` by ICP with
+/// `refine` (range-bias offsets included), then verified with `config.verify`, with those
+/// offsets applied when `config.offsets_in_verification`. Public so that evaluations score
+/// other poses (the truth, say) exactly as the pipeline scores its candidates.
+pub fn refine_and_score(
+    a: &PreparedMap,
+    b: &PreparedMap,
+    start: &Rigid2,
+    refine: &RefineConfig,
+    config: &PairConfig,
+) -> (Rigid2, Verification) {
+    let (transform, offsets) = refine_with_bias(a, b, start, refine);
+    let transform = transform.normalized();
+    let v = if config.offsets_in_verification {
+        verify_with_offsets(a, b, &transform, offsets, &config.verify)
+    } else {
+        verify(a, b, &transform, &config.verify)
+    };
+    (transform, v)
+}
+
 /// Register `b` onto `a` using the correspondences of `sources`.
 ///
 /// Never fails: a pair without a trustworthy answer comes back with `accepted: None` and a
@@ -415,16 +436,7 @@ pub fn register_with(
         } else {
             config.turn_search.as_ref()
         };
-        let refined = |start: &Rigid2| {
-            let (transform, offsets) = refine_with_bias(&pa, &pb, start, refine_config);
-            let transform = transform.normalized();
-            let v = if config.offsets_in_verification {
-                verify_with_offsets(&pa, &pb, &transform, offsets, &config.verify)
-            } else {
-                verify(&pa, &pb, &transform, &config.verify)
-            };
-            (transform, v)
-        };
+        let refined = |start: &Rigid2| refine_and_score(&pa, &pb, start, refine_config, config);
         let searched = |sc: Option<&SearchConfig>| {
             let moved = local_search(&pa, &pb, model, sc?);
             (moved != *model).then(|| refined(&moved))
