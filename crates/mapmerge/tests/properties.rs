@@ -90,7 +90,7 @@ proptest! {
     /// square room: the answer is the truth turned by half a turn (91 px off, wall lift 0.88,
     /// contradiction 0.04, 86 % overlap) and the truth fits worse (wall lift 0.78,
     /// contradiction 0.14, 61 % overlap), so no rule that prefers the better fit can pick it
-    /// (docs/EVALUATION.md, "Tried on 2026-12-02, 05:00-06:00 UTC").
+    /// (docs/EVALUATION.md, "Tried on 2026-12-02, 05:00-07:10 UTC").
     /// The failing cases are kept in `properties.proptest-regressions`,
     /// so `cargo test -p mapmerge --test properties -- --ignored` shows them first.
     #[test]
