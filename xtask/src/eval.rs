@@ -73,6 +73,15 @@ pub struct EvalArgs {
     /// calibration experiments.
     #[arg(long)]
     sweep_keep: Option<usize>,
+    /// Override how many placements of the rotation sweep's normalised ranking are kept
+    /// besides the plain ones (default: the library's), for calibration experiments.
+    #[arg(long)]
+    sweep_keep_normalized: Option<usize>,
+    /// Override how many translations per angle the rotation sweep keeps before ranking the
+    /// placements of all angles (default: the library's; `1` was the rule before
+    /// `mapmerge::global::SweepConfig::translation_peaks`), for calibration experiments.
+    #[arg(long)]
+    sweep_peaks: Option<usize>,
     /// Override the rotation sweep's coarse image size (default: the library's), for
     /// calibration experiments.
     #[arg(long)]
@@ -401,6 +410,12 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
     if let Some(sweep) = config.pair.sweep.as_mut() {
         if let Some(k) = args.sweep_keep {
             sweep.keep = k;
+        }
+        if let Some(k) = args.sweep_keep_normalized {
+            sweep.keep_normalized = k;
+        }
+        if let Some(p) = args.sweep_peaks {
+            sweep.translation_peaks = p;
         }
         if let Some(n) = args.sweep_size {
             sweep.coarse_size = n;
