@@ -505,7 +505,8 @@ pub struct SweepConfig {
     /// registered at seeds 7, 3 and 4: 55, 25 and 40 % with one translation and 8 normalised
     /// placements (the rule before), 65, 25 and 45 % with 10 and 24, 60, 30 and 45 % with 10
     /// and 40; at seed 7 alone 50 % with 10 and 8, 55 % with 1 and 40; indoor 30 % unchanged
-    /// in each (95, 85, 80 %). Swept pairs take about 10-20 % longer with 10 and 24.
+    /// in each (95, 85, 80 %). Swept pairs take about 10-35 % longer with 10 and 24 (see
+    /// "What the sweep's lesser peaks changed" in `docs/EVALUATION.md`).
     pub translation_peaks: usize,
     /// Two placements are distinct when B's wall centre lands this far apart under them, or
     /// their angles differ by more than twice the step. Default 12 px.
