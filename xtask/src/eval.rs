@@ -82,6 +82,11 @@ pub struct EvalArgs {
     /// `mapmerge::global::SweepConfig::translation_peaks`), for calibration experiments.
     #[arg(long)]
     sweep_peaks: Option<usize>,
+    /// Override how many placements of the rotation sweep's normalised ranking are screened by
+    /// the local search before the best are refined (`mapmerge::global::SweepConfig::screened`;
+    /// `0` screens none; default: the library's), for calibration experiments.
+    #[arg(long)]
+    sweep_screen: Option<usize>,
     /// Override the rotation sweep's coarse image size (default: the library's), for
     /// calibration experiments.
     #[arg(long)]
@@ -416,6 +421,9 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
         }
         if let Some(p) = args.sweep_peaks {
             sweep.translation_peaks = p;
+        }
+        if let Some(n) = args.sweep_screen {
+            sweep.screened = n;
         }
         if let Some(n) = args.sweep_size {
             sweep.coarse_size = n;

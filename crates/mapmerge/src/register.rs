@@ -10,7 +10,7 @@ use ransac_rigid::{RansacConfig, estimate_rigid};
 use sift_desc::{SiftConfig, SiftCorrespondences};
 
 use crate::global::{
-    GlobalConfig, SweepConfig, global_hypotheses, spectrum_rotation_near, sweep_hypotheses, twins,
+    GlobalConfig, SweepConfig, global_hypotheses, spectrum_rotation_near, sweep_placements, twins,
 };
 use crate::refine::{RefineConfig, refine_with_bias};
 use crate::search::{SearchConfig, local_search};
@@ -367,6 +367,40 @@ pub fn refine_and_score(
     (transform, v)
 }
 
+/// The `keep` of `placements` that the maps agree with most once the correlative local search
+/// (`config.search`, if any) has moved them: a cheap screen before the full refinement, for a
+/// coarse ranking that puts the truth too far down (see [`SweepConfig::screened`]). Returns
+/// the placements themselves, best screened first; all of them, in order, when there are no
+/// more than `keep`. Deterministic: ties keep the given order.
+fn screen(
+    a: &PreparedMap,
+    b: &PreparedMap,
+    placements: Vec<Rigid2>,
+    keep: usize,
+    config: &PairConfig,
+) -> Vec<Rigid2> {
+    if placements.len() <= keep {
+        return placements;
+    }
+    let scores: Vec<f64> = placements
+        .par_iter()
+        .map(|p| {
+            let moved = config
+                .search
+                .as_ref()
+                .map_or(*p, |sc| local_search(a, b, p, sc));
+            verify(a, b, &moved, &config.verify).score()
+        })
+        .collect();
+    let mut order: Vec<usize> = (0..placements.len()).collect();
+    order.sort_by(|&i, &j| scores[j].total_cmp(&scores[i]));
+    order
+        .into_iter()
+        .take(keep)
+        .map(|i| placements[i])
+        .collect()
+}
+
 /// Register `b` onto `a` using the correspondences of `sources`.
 ///
 /// Never fails: a pair without a trustworthy answer comes back with `accepted: None` and a
@@ -505,7 +539,21 @@ pub fn register_with(
             .iter()
             .any(|c| confident(c, sweep.confident_wall_lift))
     {
-        let (found, t) = search(&|out| sweep_hypotheses(&pa, &pb, sweep, out), Origin::Sweep);
+        let (found, t) = search(
+            &|out| {
+                let found =
+                    sweep_placements(&pa, &pb, sweep, sweep.screened.max(sweep.keep_normalized));
+                out.extend(found.plain);
+                out.extend(screen(
+                    &pa,
+                    &pb,
+                    found.normalized,
+                    sweep.keep_normalized,
+                    config,
+                ));
+            },
+            Origin::Sweep,
+        );
         candidates.extend(found);
         timings.sweep_ms = t;
     }
@@ -793,6 +841,30 @@ mod tests {
             "{:?}",
             r.candidates
         );
+    }
+
+    #[test]
+    fn the_screen_keeps_the_placements_that_fit_once_searched() {
+        // B is the room moved by (7, -4) px; the placements are the truth moved 5 px (within
+        // the local search's reach), and wrong ones: a half turn, and far shifts.
+        let a = room();
+        let truth = Rigid2::new(0.0, -7.0, 4.0);
+        let b = a.warp(&truth.inverse(), 120, 100).unwrap();
+        let vc = VerifyConfig::default();
+        let (pa, pb) = (PreparedMap::new(&a, &vc), PreparedMap::new(&b, &vc));
+        let near = Rigid2::new(0.0, -2.0, 4.0);
+        let wrong = [
+            Rigid2::new(std::f64::consts::PI, 120.0, 100.0),
+            Rigid2::new(0.0, 40.0, 0.0),
+            Rigid2::new(0.0, -7.0, 45.0),
+        ];
+        let config = PairConfig::default();
+        let placements = vec![wrong[0], wrong[1], near, wrong[2]];
+        assert_eq!(screen(&pa, &pb, placements.clone(), 1, &config), vec![near]);
+        let two = screen(&pa, &pb, placements.clone(), 2, &config);
+        assert_eq!((two.len(), two[0]), (2, near));
+        // No more placements than kept: all of them, in their order, unscreened.
+        assert_eq!(screen(&pa, &pb, placements.clone(), 4, &config), placements);
     }
 
     #[test]
