@@ -506,7 +506,7 @@ pub struct SweepConfig {
     /// placements (the rule before), 65, 25 and 45 % with 10 and 24, 60, 30 and 45 % with 10
     /// and 40; at seed 7 alone 50 % with 10 and 8, 55 % with 1 and 40; indoor 30 % unchanged
     /// in each (95, 85, 80 %). Swept pairs take about 10-35 % longer with 10 and 24 (see
-    /// "What the sweep's lesser peaks changed" in `docs/EVALUATION.md`).
+    /// "What the sweep's lesser peaks and the screen changed" in `docs/EVALUATION.md`).
     pub translation_peaks: usize,
     /// Placements of the normalised ranking screened before the `keep_normalized` best are
     /// refined: [`crate::register_with`] runs its correlative local search from each of the
@@ -521,7 +521,7 @@ pub struct SweepConfig {
     /// got one within 5.2 px; seed 7's loss is case 7000013, 2.99 -> 3.11 px), 55, 30 and 50 %
     /// keeping 12 of the 100; indoor 30 % unchanged (95, 85, 80 %). With the lesser peaks it
     /// raised the mean time per case of the eval table's rows by 10-60 % (`docs/EVALUATION.md`,
-    /// "What the sweep's lesser peaks changed").
+    /// "What the sweep's lesser peaks and the screen changed").
     pub screened: usize,
     /// Two placements are distinct when B's wall centre lands this far apart under them, or
     /// their angles differ by more than twice the step. Default 12 px.
