@@ -584,7 +584,8 @@ impl Default for SweepConfig {
 /// Unlike the Hough spectrum, which reads the rotation off the maps' dominant wall directions
 /// and fails when the shared part is small next to the rest, the sweep tries every angle; it
 /// costs one FFT correlation per angle (180 at the default step), so [`crate::register_with`]
-/// runs it last, and not after a feature-based candidate that passed with a good fit.
+/// runs it (as [`sweep_placements`], screening the normalised ranking) last, and not after a
+/// feature-based candidate that passed with a good fit.
 /// Deterministic: the angles are independent and their results are merged in angle order.
 pub fn sweep_hypotheses(
     a: &PreparedMap,
@@ -607,17 +608,16 @@ pub struct SweepPlacements {
     pub normalized: Vec<Rigid2>,
 }
 
-/// The rotation sweep of [`sweep_hypotheses`], its two rankings apart and `normalized` (rather
-/// than `keep_normalized`) placements taken from the normalised one, for a caller that screens
-/// them (see [`SweepConfig::screened`]).
+/// The rotation sweep of [`sweep_hypotheses`], its two rankings apart and `normalized_count`
+/// (rather than `keep_normalized`) placements taken from the normalised one, for a caller that
+/// screens them (see [`SweepConfig::screened`]).
 pub fn sweep_placements(
     a: &PreparedMap,
     b: &PreparedMap,
     config: &SweepConfig,
-    normalized: usize,
+    normalized_count: usize,
 ) -> SweepPlacements {
     use rayon::prelude::*;
-    let normalized_count = normalized;
     let pb = strided(&b.wall_samples, config.max_points);
     if pb.len() < 10
         || a.wall_samples.len() < 10
