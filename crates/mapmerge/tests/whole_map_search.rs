@@ -50,24 +50,27 @@ fn with_former_sweep(mut config: RegisterConfig) -> RegisterConfig {
     config
 }
 
+/// Case `seed` (see [`disaster_30_error`]) is registered within 3 px with `with` and not
+/// without `what` (declined, or answered more than 3 px off), `without` being `with` less it.
+fn registered_only_with(seed: u64, with: &RegisterConfig, without: &RegisterConfig, what: &str) {
+    let error = disaster_30_error(seed, with);
+    assert!(error.is_some_and(|e| e <= 3.0), "with {what}: {error:?} px");
+    let error = disaster_30_error(seed, without);
+    assert!(
+        error.is_none_or(|e| e > 3.0),
+        "without {what}: {error:?} px (the test no longer shows what it adds)"
+    );
+}
+
 /// Case 19: no keypoint agrees, and the rotation sweep's nearest placement (with the former
 /// sweep; the present one proposes a nearer one) is about 8 px and a degree off, where ICP and
 /// the translation-only search settle 8-9 px from the truth and the pair was declined.
 #[test]
 fn a_disaster_pair_at_30_percent_overlap_is_registered_after_the_turn_search() {
-    let error = |config: &RegisterConfig| disaster_30_error(7_000_019, config);
-    let with = error(&with_former_sweep(RegisterConfig::default()));
-    assert!(
-        with.is_some_and(|e| e <= 3.0),
-        "with the turn search: {with:?} px"
-    );
-    let mut without = RegisterConfig::default();
+    let with = with_former_sweep(RegisterConfig::default());
+    let mut without = with.clone();
     without.pair.turn_search = None;
-    let without = error(&with_former_sweep(without));
-    assert!(
-        without.is_none_or(|e| e > 3.0),
-        "without the turn search: {without:?} px (the test no longer shows what it adds)"
-    );
+    registered_only_with(7_000_019, &with, &without, "the turn search");
 }
 
 /// Case 14: most of B's walls at the truth land on A's unknown area, and at the true angle the
@@ -77,17 +80,13 @@ fn a_disaster_pair_at_30_percent_overlap_is_registered_after_the_turn_search() {
 /// translation per angle and eight placements per ranking.
 #[test]
 fn a_disaster_pair_at_30_percent_overlap_is_registered_from_a_lesser_sweep_peak() {
-    let error = |config: &RegisterConfig| disaster_30_error(7_000_014, config);
-    let with = error(&RegisterConfig::default());
-    assert!(
-        with.is_some_and(|e| e <= 3.0),
-        "with the sweep's defaults: {with:?} px"
-    );
-    let before = error(&with_former_sweep(RegisterConfig::default()));
-    assert!(
-        before.is_none_or(|e| e > 3.0),
-        "one peak per angle, 8 placements: {before:?} px (the test no longer shows what the \
-         defaults add)"
+    let with = RegisterConfig::default();
+    let without = with_former_sweep(with.clone());
+    registered_only_with(
+        7_000_014,
+        &with,
+        &without,
+        "the sweep's lesser peaks and screen",
     );
 }
 
@@ -97,17 +96,8 @@ fn a_disaster_pair_at_30_percent_overlap_is_registered_from_a_lesser_sweep_peak(
 /// declined before, is registered.
 #[test]
 fn a_disaster_pair_at_30_percent_overlap_is_registered_after_the_screen() {
-    let error = |config: &RegisterConfig| disaster_30_error(3_000_018, config);
-    let with = error(&RegisterConfig::default());
-    assert!(
-        with.is_some_and(|e| e <= 3.0),
-        "with the screen: {with:?} px"
-    );
-    let mut without = RegisterConfig::default();
+    let with = RegisterConfig::default();
+    let mut without = with.clone();
     without.pair.sweep.as_mut().unwrap().screened = 0;
-    let without = error(&without);
-    assert!(
-        without.is_none_or(|e| e > 3.0),
-        "without the screen: {without:?} px (the test no longer shows what it adds)"
-    );
+    registered_only_with(3_000_018, &with, &without, "the screen");
 }
