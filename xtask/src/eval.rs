@@ -20,6 +20,7 @@ use mapmerge::{Method, RegisterConfig, refine_and_score, register};
 use mapsim::{Case, CaseConfig, RobotConfig, WorldConfig, WorldKind, generate_case};
 use rayon::prelude::*;
 
+use crate::r#gen::Mapper;
 use crate::picture;
 
 /// Arguments of `cargo xtask eval`.
@@ -128,6 +129,11 @@ pub struct EvalArgs {
     /// default: the library's), to measure what it adds.
     #[arg(long)]
     range_bias: Option<f64>,
+    /// How the simulated robots fold their beams into their maps (`default`, or `hector`:
+    /// gentle clearing, so noisy walls stay as speckle; see `cargo xtask gen --help`). Row
+    /// labels name a mapper other than the default.
+    #[arg(long, value_enum, default_value = "default")]
+    mapper: Mapper,
     /// Only the rows whose label contains this text (e.g. `"overlap 0.3"`).
     #[arg(long)]
     only: Option<String>,
@@ -221,7 +227,7 @@ fn case(world: WorldConfig, robots: Vec<RobotConfig>, overlap: f64) -> CaseConfi
     }
 }
 
-fn rows(suites: &[String], size: usize) -> Result<Vec<Row>> {
+fn rows(suites: &[String], size: usize, mapper: Mapper) -> Result<Vec<Row>> {
     let all = suites.iter().any(|s| s == "all");
     let want = |name: &str| all || suites.iter().any(|s| s == name);
     let kinds = [
@@ -346,6 +352,12 @@ fn rows(suites: &[String], size: usize) -> Result<Vec<Row>> {
         }
     }
     anyhow::ensure!(!rows.is_empty(), "no known suite in {suites:?}");
+    if mapper != Mapper::Default {
+        for row in &mut rows {
+            row.config.inverse_model = mapper.model();
+            row.label = format!("{}, {} mapper", row.label, mapper.name());
+        }
+    }
     Ok(rows)
 }
 
@@ -661,7 +673,7 @@ fn export(rows: &[Row], jobs: &[(usize, u64)], dir: &Path, bar: &ProgressBar) ->
 
 /// Run `cargo xtask eval`.
 pub fn run(args: EvalArgs) -> Result<()> {
-    let rows = rows(&args.suites, args.size)?;
+    let rows = rows(&args.suites, args.size, args.mapper)?;
     let defaults = register_config(&args);
     // A row keeps its index among the selected suites' rows with or without `--only`, so the
     // filtered run draws the same cases as the full one.

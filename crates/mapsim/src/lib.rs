@@ -23,8 +23,10 @@
 //! overshoot clear the cells just behind an obstacle's face, and nothing clears the far end of
 //! the band, so walls settle near `r (1 + b)`: pushed away from the robot by about `b r` cells,
 //! differently in each robot's map. At 30-50 % a beam that reads long passes through thin
-//! rubble, and most obstacles disappear from the map. A real mapper fed such a sensor does the
-//! same; registration has to live with it (see `docs/EVALUATION.md`).
+//! rubble, and with the default [`InverseSensorModel`] most obstacles disappear from the map;
+//! a mapper that clears gently ([`InverseSensorModel::hector`]) keeps them as bands of speckle.
+//! Real mappers do one or the other; registration has to live with both (see
+//! `docs/EVALUATION.md`).
 //!
 //! Cost (`cargo bench -p mapsim`, 2-core AMD EPYC VM): the paper preset takes 14 ms, a
 //! 400 x 400 case with two 360-beam lidars about 0.5 s. A 4000 x 4000 case with range 300
@@ -161,6 +163,52 @@ pub struct CaseConfig {
     pub clearance: f64,
     /// Spacing of the exploration waypoints in cells; `None` = 0.8 x the smallest max range.
     pub waypoint_spacing: Option<f64>,
+    /// How every robot's mapper folds beams into its log-odds grid. Default
+    /// [`InverseSensorModel::default`].
+    pub inverse_model: InverseSensorModel,
+}
+
+/// The mapper's inverse sensor model: the log-odds added to a cell a beam passes through
+/// (`free`, negative) and to the cell it ends in (`occupied`, positive), both clamped to
+/// `[-clamp, clamp]`. A cell's final log-odds becomes its percent; what lies between the free
+/// and occupied thresholds reads as unknown (`OccupancyGrid::classify`).
+///
+/// How strongly `free` clears against `occupied` decides what range noise leaves of the
+/// walls. The default (`free` -1.4, `occupied` 2.2: cell probabilities 0.2 and 0.9) clears
+/// hard, so under strong noise obstacles that beams read past fade away. Hector mapping's
+/// defaults (`update_factor_free` 0.4, `update_factor_occupied` 0.9: log-odds -0.405 and
+/// 2.197, [`Self::hector`]) and OctoMap's (0.4 and 0.7) clear gently, so a noisy wall stays
+/// as a band of speckle: the same sensor gives another map, and registration should do on
+/// both.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct InverseSensorModel {
+    /// Log-odds added to each cell a beam passes through. Default -1.4.
+    pub free: f32,
+    /// Log-odds added to the cell a beam ends in. Default 2.2.
+    pub occupied: f32,
+    /// Bound of the log-odds magnitude. Default 5.0.
+    pub clamp: f32,
+}
+
+impl Default for InverseSensorModel {
+    fn default() -> Self {
+        Self {
+            free: -1.4,
+            occupied: 2.2,
+            clamp: 5.0,
+        }
+    }
+}
+
+impl InverseSensorModel {
+    /// Hector mapping's defaults: cell probabilities 0.4 for a pass, 0.9 for a hit.
+    pub fn hector() -> Self {
+        Self {
+            free: (0.4f32 / 0.6).ln(),
+            occupied: (0.9f32 / 0.1).ln(),
+            clamp: 5.0,
+        }
+    }
 }
 
 impl Default for CaseConfig {
@@ -176,6 +224,7 @@ impl Default for CaseConfig {
             pose_step: 2.0,
             clearance: 3.0,
             waypoint_spacing: None,
+            inverse_model: InverseSensorModel::default(),
         }
     }
 }
@@ -258,6 +307,16 @@ impl CaseConfig {
             && !(s.is_finite() && s >= 2.0)
         {
             return bad(format!("waypoint_spacing {s} (need >= 2)"));
+        }
+        let m = &self.inverse_model;
+        if !(m.free.is_finite() && m.free < 0.0)
+            || !(m.occupied.is_finite() && m.occupied > 0.0)
+            || !(m.clamp.is_finite() && m.clamp > 0.0)
+        {
+            return bad(format!(
+                "inverse_model free {} occupied {} clamp {} (need free < 0 < occupied, clamp > 0)",
+                m.free, m.occupied, m.clamp
+            ));
         }
         Ok(())
     }

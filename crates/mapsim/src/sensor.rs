@@ -97,9 +97,6 @@ pub(crate) fn measure(
 }
 
 /// Log-odds increments of the inverse sensor model and the clamp that keeps cells revisable.
-const L_FREE: f32 = -1.4;
-const L_OCC: f32 = 2.2;
-const L_CLAMP: f32 = 5.0;
 
 /// The robot's map in its own frame: a random rotation, a canvas cropped to the explored area
 /// plus a margin. Returns the map and the transform mapping a map pixel to a world pixel.
@@ -148,6 +145,7 @@ pub(crate) fn build_map(
     let (w, h) = (size.x as usize + 1, size.y as usize + 1);
     let world_to_map = Rigid2::new(theta, t.x, t.y);
 
+    let model = case.inverse_model;
     let mut logodds = vec![0f32; w * h];
     let mut seen = vec![false; w * h];
     let idx = |x: i64, y: i64| {
@@ -168,11 +166,11 @@ pub(crate) fn build_map(
                 return true;
             };
             if s < r.len {
-                logodds[i] = (logodds[i] + L_FREE).max(-L_CLAMP);
+                logodds[i] = (logodds[i] + model.free).max(-model.clamp);
                 seen[i] = true;
                 true
             } else if !occ_done {
-                logodds[i] = (logodds[i] + L_OCC).min(L_CLAMP);
+                logodds[i] = (logodds[i] + model.occupied).min(model.clamp);
                 seen[i] = true;
                 occ_done = true;
                 false
