@@ -58,6 +58,10 @@ pub struct EvalArgs {
     /// calibration experiments.
     #[arg(long)]
     wall_tolerance: Option<f32>,
+    /// Override the ambiguity test's basin ratio (`mapmerge::VerifyConfig::basin_ratio`; `0`
+    /// turns the basin test off; default: the library's), to measure what it changes.
+    #[arg(long)]
+    basin_ratio: Option<f64>,
     /// Override SIFT's nearest / second-nearest ratio (default: the library's), for
     /// calibration experiments.
     #[arg(long)]
@@ -401,6 +405,9 @@ struct Outcome {
 /// The registration settings the flags describe (the library's defaults unless overridden).
 fn register_config(args: &EvalArgs) -> RegisterConfig {
     let mut config = RegisterConfig::default();
+    if let Some(r) = args.basin_ratio {
+        config.pair.verify.basin_ratio = r;
+    }
     if let Some(t) = args.wall_tolerance {
         config.pair.verify.wall_tolerance_px = t;
     }

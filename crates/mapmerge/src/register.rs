@@ -342,6 +342,28 @@ fn rivals(best: &Verification, c: &Candidate, config: &VerifyConfig) -> bool {
         && v.wall_contradiction <= best.wall_contradiction + config.max_contradiction_excess
 }
 
+/// Whether placements `x` and `y` are one broad optimum rather than two answers: the placement
+/// halfway between them fits at least [`VerifyConfig::basin_ratio`] as well as the poorer of
+/// the two (all three scored by [`verify`], without range-bias offsets). Between two genuine
+/// answers (a quarter turn, the next bay of a repetitive floor) the walls pass through free
+/// space and the score falls; across a wall band that a noisy sensor smeared over 10-20 px,
+/// it does not.
+fn one_basin(
+    a: &PreparedMap,
+    b: &PreparedMap,
+    x: &Rigid2,
+    y: &Rigid2,
+    config: &VerifyConfig,
+) -> bool {
+    if config.basin_ratio <= 0.0 {
+        return false;
+    }
+    let half = grid_core::wrap_angle(y.theta - x.theta) / 2.0;
+    let mid = Rigid2::new(x.theta + half, (x.tx + y.tx) / 2.0, (x.ty + y.ty) / 2.0);
+    let score = |t: &Rigid2| verify(a, b, t, config).score();
+    score(&mid) >= config.basin_ratio * score(x).min(score(y))
+}
+
 fn ms(t: Instant) -> f64 {
     t.elapsed().as_secs_f64() * 1e3
 }
@@ -644,6 +666,7 @@ pub fn register_with(
         candidates.iter().skip(1).find(|c| {
             rivals(&best.verification, c, &config.verify)
                 && apart(&c.transform, &best.transform) > config.verify.distinct_px
+                && !one_basin(&pa, &pb, &best.transform, &c.transform, &config.verify)
         })
     });
     if let (Some(best), Some(rival)) = (candidates.first(), rival) {

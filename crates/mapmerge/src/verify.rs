@@ -77,6 +77,18 @@ pub struct VerifyConfig {
     /// a twin of a room with a little inner structure (a half wall, a pillar) fits the outer
     /// walls as well as the truth, but puts the inner structure in free space.
     pub max_contradiction_excess: f64,
+    /// A placement that would be a rival of the best (see `max_ambiguity`) is not one when the
+    /// placement halfway between the two scores at least this fraction of the poorer of them:
+    /// no valley separates them, so they are one broad optimum (walls that a noisy sensor
+    /// smeared into wide bands fit over a range of placements), not two answers. `0` turns the
+    /// test off. Default 0.9. On `cargo xtask eval --suites overlap,zero,paper,real,noise
+    /// --cases 20 --seed 7`, with `--mapper hector` and without, it decided 7 pairs: rivals
+    /// 10-13 px from the best (mean over B's walls), turned 3-7 degrees from it, whose midpoint
+    /// scored 1.04-1.25 times the poorer of the two. Four became answers within 3 px (the
+    /// hector mapper's speckled walls), three answers 3-10 px off (real floors with 10 %/20 %
+    /// noise, where the ambiguity test had declined imprecise answers); no zero-overlap pair
+    /// was accepted (`docs/EVALUATION.md`).
+    pub basin_ratio: f64,
 }
 
 impl Default for VerifyConfig {
@@ -93,6 +105,7 @@ impl Default for VerifyConfig {
             max_ambiguity: 0.6,
             distinct_px: 10.0,
             max_contradiction_excess: 0.05,
+            basin_ratio: 0.9,
         }
     }
 }
