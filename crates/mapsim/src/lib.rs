@@ -309,10 +309,13 @@ impl CaseConfig {
             return bad(format!("waypoint_spacing {s} (need >= 2)"));
         }
         let m = &self.inverse_model;
-        if !(m.free.is_finite() && m.free < 0.0)
-            || !(m.occupied.is_finite() && m.occupied > 0.0)
-            || !(m.clamp.is_finite() && m.clamp > 0.0)
-        {
+        let valid = m.free.is_finite()
+            && m.free < 0.0
+            && m.occupied.is_finite()
+            && m.occupied > 0.0
+            && m.clamp.is_finite()
+            && m.clamp > 0.0;
+        if !valid {
             return bad(format!(
                 "inverse_model free {} occupied {} clamp {} (need free < 0 < occupied, clamp > 0)",
                 m.free, m.occupied, m.clamp

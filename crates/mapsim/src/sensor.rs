@@ -96,8 +96,6 @@ pub(crate) fn measure(
     rays
 }
 
-/// Log-odds increments of the inverse sensor model and the clamp that keeps cells revisable.
-
 /// The robot's map in its own frame: a random rotation, a canvas cropped to the explored area
 /// plus a margin. Returns the map and the transform mapping a map pixel to a world pixel.
 pub(crate) fn build_map(
