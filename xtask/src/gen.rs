@@ -33,7 +33,7 @@ pub enum Mapper {
     Default,
     /// Hector mapping's defaults: a pass adds log-odds -0.41 (probability 0.4), a hit 2.2
     /// (0.9). Clears gently: under strong noise a wall stays as a band of speckle, and a cell
-    /// needs four passes to read free.
+    /// needs several passes to read free.
     Hector,
 }
 
@@ -47,11 +47,11 @@ impl Mapper {
     }
 
     /// The mapper's name on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            Mapper::Default => "default",
-            Mapper::Hector => "hector",
-        }
+    pub fn name(self) -> String {
+        self.to_possible_value()
+            .expect("no variant is skipped")
+            .get_name()
+            .to_owned()
     }
 }
 
