@@ -83,12 +83,13 @@ pub struct VerifyConfig {
     /// smeared into wide bands fit over a range of placements), not two answers. `0` turns the
     /// test off. Default 0.9. On `cargo xtask eval --suites overlap,zero,paper,real,noise
     /// --cases 20 --seed 7`, and on its `--suites noise` and `--suites overlap,zero` with
-    /// `--mapper hector`, it decided 7 pairs: rivals
-    /// 10-13 px from the best (mean over B's walls), turned 3-7 degrees from it, whose midpoint
-    /// scored 1.04-1.25 times the poorer of the two. Four became answers within 3 px (the
-    /// hector mapper's speckled walls), three answers 3-10 px off (real floors with 10 %/20 %
-    /// noise, where the ambiguity test had declined imprecise answers); no zero-overlap pair
-    /// was accepted (`docs/EVALUATION.md`).
+    /// `--mapper hector`, it decided 7 pairs: rivals 10-13 px from the best (mean over B's
+    /// walls), turned 3-7 degrees from it, whose midpoint scored 1.04-1.25 times the poorer of
+    /// the two (distances and scores from a diagnostic print, not in the repo; the outcomes are
+    /// in the eval's JSONL). Four became answers within 3 px (the hector mapper's speckled
+    /// walls), three answers 3-10 px off (real floors with 10 %/20 % noise, where the ambiguity
+    /// test had declined imprecise answers); no zero-overlap pair was accepted
+    /// (`docs/EVALUATION.md`).
     pub basin_ratio: f64,
 }
 

@@ -117,7 +117,8 @@ fn a_disaster_pair_at_30_percent_overlap_is_registered_after_the_screen() {
 /// the truth scores best; another, 11 px from it on average over B's walls and turned 3
 /// degrees, scores almost as well (0.88 of it, scored without range-bias offsets), which made
 /// the pair ambiguous. The placement halfway between the two scores as well as the best: one
-/// broad optimum, not two answers.
+/// broad optimum, not two answers. (Distances and scores from a diagnostic print, not in the
+/// repo; the test checks the outcomes.)
 #[test]
 fn a_rival_in_the_best_placements_basin_does_not_make_the_pair_ambiguous() {
     let case = disaster_case(7_001_019, 0.5, 0.3, InverseSensorModel::hector());
