@@ -14,7 +14,9 @@ use crate::global::{
 };
 use crate::refine::{RefineConfig, refine_with_bias};
 use crate::search::{SearchConfig, local_search};
-use crate::verify::{PreparedMap, Verification, VerifyConfig, verify, verify_with_offsets};
+use crate::verify::{
+    PreparedMap, StandOut, Verification, VerifyConfig, verify, verify_with_offsets,
+};
 
 /// Everything that tunes [`register_with`], with documented defaults.
 #[derive(Debug, Clone)]
@@ -227,6 +229,9 @@ pub struct Candidate {
     pub verification: Verification,
     /// Whether it passes the verification thresholds.
     pub accepted: bool,
+    /// Whether it was accepted because it stands out from every other placement
+    /// ([`crate::verify::StandOut`]) rather than by the wall lift bars.
+    pub stands_out: bool,
     /// Where the hypothesis came from.
     pub origin: Origin,
 }
@@ -362,6 +367,47 @@ fn one_basin(
     let mid = Rigid2::new(x.theta + half, (x.tx + y.tx) / 2.0, (x.ty + y.ty) / 2.0);
     let score = |t: &Rigid2| verify(a, b, t, config).score();
     score(&mid) >= config.basin_ratio * score(x).min(score(y))
+}
+
+/// The candidate [`StandOut`] accepts when none passed the wall lift bars: of those that pass
+/// all but the wall tests with a wide lift of at least `rule.min_wide_wall_lift` and a wall
+/// density of at least `rule.min_wall_density`, the best scoring, if it [`stands_out`].
+/// `apart` measures how far apart two placements put B's walls.
+fn standing_out(
+    candidates: &[Candidate],
+    rule: &StandOut,
+    config: &VerifyConfig,
+    apart: &dyn Fn(&Rigid2, &Rigid2) -> f64,
+) -> Option<usize> {
+    let (i, c) = candidates
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| {
+            c.verification.wide_wall_lift >= rule.min_wide_wall_lift
+                && c.verification.wall_density >= rule.min_wall_density
+                && c.verification.passes_all_but_walls(config)
+        })
+        .max_by(|(_, x), (_, y)| x.verification.score().total_cmp(&y.verification.score()))?;
+    stands_out(candidates, c, rule, config, apart).then_some(i)
+}
+
+/// Whether every candidate that passes all but the wall tests and lies more than
+/// `rule.distance_px` from `c` has a wide lift at least `rule.margin` below `c`'s.
+fn stands_out(
+    candidates: &[Candidate],
+    c: &Candidate,
+    rule: &StandOut,
+    config: &VerifyConfig,
+    apart: &dyn Fn(&Rigid2, &Rigid2) -> f64,
+) -> bool {
+    let bar = c.verification.wide_wall_lift - rule.margin;
+    candidates
+        .iter()
+        .filter(|o| {
+            o.verification.passes_all_but_walls(config)
+                && apart(&o.transform, &c.transform) > rule.distance_px
+        })
+        .all(|o| o.verification.wide_wall_lift <= bar)
 }
 
 fn ms(t: Instant) -> f64 {
@@ -512,6 +558,7 @@ pub fn register_with(
             ransac_inliers: 0,
             ransac_confidence: 0.0,
             accepted: verification.accepted(&config.verify),
+            stands_out: false,
             verification,
             origin,
         }
@@ -587,6 +634,26 @@ pub fn register_with(
         })
     };
     rank(&mut candidates);
+    // How far apart two placements put B's walls, on average (the ambiguity test's and the
+    // stand-out rule's measure of "different").
+    let probe = crate::verify::strided(&pb.wall_samples, 500);
+    let apart = |x: &Rigid2, y: &Rigid2| {
+        probe
+            .iter()
+            .map(|p| (x.apply(*p) - y.apply(*p)).length())
+            .sum::<f64>()
+            / probe.len().max(1) as f64
+    };
+    // Nothing passed the bars: a placement may still stand out from every other (speckled
+    // walls of a very noisy sensor). It is then probed for twins like any accepted answer.
+    if let Some(rule) = &config.verify.stand_out
+        && candidates.first().is_some_and(|c| !c.accepted)
+        && let Some(i) = standing_out(&candidates, rule, &config.verify, &apart)
+    {
+        candidates[i].accepted = true;
+        candidates[i].stands_out = true;
+        rank(&mut candidates);
+    }
     if config.symmetry_probes
         && let Some(best) = candidates
             .first()
@@ -608,6 +675,16 @@ pub fn register_with(
         candidates.extend(found);
         rank(&mut candidates);
         timings.symmetry_ms = ms(t0);
+    }
+    // A placement that stood out must still stand out from the twins the probes found.
+    if let Some(rule) = &config.verify.stand_out
+        && let Some(best) = candidates.first()
+        && best.stands_out
+        && !stands_out(&candidates, best, rule, &config.verify, &apart)
+    {
+        candidates[0].accepted = false;
+        candidates[0].stands_out = false;
+        rank(&mut candidates);
     }
     // The best candidate, when its walls agree almost everywhere, is polished (only the best:
     // on the 2048 bench pair polishing every RANSAC candidate cost about 35 ms).
@@ -648,20 +725,18 @@ pub fn register_with(
         };
         let (t, offsets) = refine_with_bias(&pa, &pb, &start, &locked);
         let v = verify_with_offsets(&pa, &pb, &t, offsets, &config.verify);
-        if v.accepted(&config.verify) {
+        // A placement that stood out keeps the angle if it stays above the rule's bars.
+        let still_out = best.stands_out
+            && v.passes_all_but_walls(&config.verify)
+            && config.verify.stand_out.is_some_and(|r| {
+                v.wide_wall_lift >= r.min_wide_wall_lift && v.wall_density >= r.min_wall_density
+            });
+        if v.accepted(&config.verify) || still_out {
             (best.transform, best.verification) = (t.normalized(), v);
         }
     }
     // Ambiguity: another accepted, clearly different placement that scores almost as well.
-    // "Different" is measured where it matters: how far apart the two put B's walls, on average.
-    let probe = crate::verify::strided(&pb.wall_samples, 500);
-    let apart = |x: &Rigid2, y: &Rigid2| {
-        probe
-            .iter()
-            .map(|p| (x.apply(*p) - y.apply(*p)).length())
-            .sum::<f64>()
-            / probe.len().max(1) as f64
-    };
+    // "Different" is measured where it matters: how far apart the two put B's walls (`apart`).
     let rival = candidates.first().filter(|b| b.accepted).and_then(|best| {
         candidates.iter().skip(1).find(|c| {
             rivals(&best.verification, c, &config.verify)
@@ -905,6 +980,7 @@ mod tests {
             ransac_confidence: 0.0,
             verification,
             accepted: true,
+            stands_out: false,
             origin: Origin::Symmetry,
         };
         let config = VerifyConfig::default();
@@ -922,6 +998,54 @@ mod tests {
             ..twin(best)
         };
         assert!(!rivals(&best, &failed, &config));
+    }
+
+    #[test]
+    fn a_placement_stands_out_only_if_every_distinct_one_fits_clearly_worse() {
+        // Candidates placed `tx` px to the right of the first; `apart` is that distance.
+        let at = |tx: f64, wide: f64, acceptance_index: f64| Candidate {
+            transform: Rigid2::new(0.0, tx, 0.0),
+            ransac_inliers: 0,
+            ransac_confidence: 0.0,
+            verification: Verification {
+                wall_lift: wide - 0.2,
+                wide_wall_lift: wide,
+                wall_support: 2000,
+                acceptance_index,
+                overlap_fraction: 0.4,
+                wall_density: 0.05,
+                ..Verification::default()
+            },
+            accepted: false,
+            stands_out: false,
+            origin: Origin::Sweep,
+        };
+        let apart = |x: &Rigid2, y: &Rigid2| (x.tx - y.tx).abs();
+        let config = VerifyConfig::default();
+        let rule = StandOut::default();
+        let margin = rule.margin;
+        let pick = |cs: &[Candidate]| standing_out(cs, &rule, &config, &apart);
+        // Below the rule's wide lift nothing is picked, however clear the margin.
+        assert_eq!(pick(&[at(0.0, 0.69, 0.95), at(100.0, 0.2, 0.95)]), None);
+        // A placement at 0.75 whose distinct rivals stay `margin` below stands out; a
+        // placement within `distance_px` of it is the same answer and is not compared.
+        let clear = [
+            at(0.0, 0.75, 0.95),
+            at(10.0, 0.76, 0.95),
+            at(100.0, 0.75 - margin - 0.01, 0.95),
+        ];
+        // The better scoring of the two near ones (higher lift) is the one picked.
+        assert_eq!(pick(&clear), Some(1));
+        // A distinct placement within the margin: nothing stands out.
+        let close = [at(0.0, 0.75, 0.95), at(100.0, 0.75 - margin + 0.01, 0.95)];
+        assert_eq!(pick(&close), None);
+        // ... unless that placement fails the acceptance index, and so is no placement at all.
+        let failed = [at(0.0, 0.75, 0.95), at(100.0, 0.75, 0.5)];
+        assert_eq!(pick(&failed), Some(0));
+        // An overlap with too little wall in it (an eroded map's border band) never stands out.
+        let mut sparse = at(0.0, 0.9, 0.95);
+        sparse.verification.wall_density = rule.min_wall_density * 0.9;
+        assert_eq!(pick(&[sparse, at(100.0, 0.2, 0.95)]), None);
     }
 
     #[test]

@@ -25,8 +25,14 @@ Output (--json): one JSON object on stdout.
                    agreement of the walls; pairs are accepted from 0.65 (or 0.8 with walls
                    compared at 4 px), with acceptance index >= 0.88 and an overlap of at
                    least 10 % of the smaller map
-  verification     wall_agreement, wall_lift, wall_contradiction (share of walls landing in the
-                   other map's free space), acceptance_index, overlap_cells, overlap_fraction
+  stands_out       true when no placement reached those bars and this one was accepted
+                   because it stands out: lift at 4 px >= 0.7 over an overlap with walls in
+                   it (wall_density >= 0.033 wall cells per cell), and every placement more
+                   than 20 px from it (mean over B's walls) lower by at least 0.3 (speckled
+                   walls of a very noisy sensor)
+  verification     wall_agreement, wall_lift, wide_wall_lift, wall_contradiction (share of walls
+                   landing in the other map's free space), acceptance_index, overlap_cells,
+                   overlap_fraction, wall_density
   method, hypothesis (ransac, global, sweep or symmetry), correspondences, candidates, timings_ms
 
 Exit codes: 0 transform found, 3 no trustworthy match (the pair is declined), 2 bad usage or
@@ -152,6 +158,7 @@ fn report(
                 "inliers_by_kind": r.inliers,
                 "confidence": c.verification.wall_lift.clamp(0.0, 1.0),
                 "verification": c.verification,
+                "stands_out": c.stands_out,
                 "hypothesis": c.origin,
             })
         }
@@ -205,6 +212,13 @@ fn human(w: &mut impl Write, o: &serde_json::Value) -> std::io::Result<()> {
             o["inliers"],
             o["hypothesis"].as_str().unwrap_or("?")
         )?;
+        if o["stands_out"].as_bool() == Some(true) {
+            writeln!(
+                w,
+                "accepted because it stands out: no placement reached the wall lift bars, and this one (lift {:.2} at 4 px) fits clearly better than every other",
+                v["wide_wall_lift"].as_f64().unwrap_or(0.0)
+            )?;
+        }
     }
     let t = &o["timings_ms"];
     let total: f64 = [
