@@ -62,6 +62,13 @@ pub struct EvalArgs {
     /// turns the basin test off; default: the library's), to measure what it changes.
     #[arg(long)]
     basin_ratio: Option<f64>,
+    /// Override the stand-out rule (`mapmerge::verify::StandOut`) as `LIFT,MARGIN`, its
+    /// minimum wide wall lift and margin (default: the library's), to measure what it changes.
+    #[arg(long, value_name = "LIFT,MARGIN", value_parser = stand_out_values, conflicts_with = "no_stand_out")]
+    stand_out: Option<(f64, f64)>,
+    /// Turn the stand-out rule off.
+    #[arg(long)]
+    no_stand_out: bool,
     /// Override SIFT's nearest / second-nearest ratio (default: the library's), for
     /// calibration experiments.
     #[arg(long)]
@@ -193,6 +200,20 @@ fn grey_values(s: &str) -> Result<[f32; 3], String> {
         &[f, o, u] if v.iter().all(|g| (0.0..=1.0).contains(g)) => Ok([f, o, u]),
         _ => Err(format!(
             "expected three grey values in [0, 1] (free,occupied,unknown), got {s:?}"
+        )),
+    }
+}
+
+/// `--stand-out LIFT,MARGIN`: two numbers in [0, 1].
+fn stand_out_values(s: &str) -> Result<(f64, f64), String> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|x| x.trim().parse::<f64>().map_err(|e| format!("{x:?}: {e}")))
+        .collect::<Result<_, _>>()?;
+    match v.as_slice() {
+        &[lift, margin] if v.iter().all(|g| (0.0..=1.0).contains(g)) => Ok((lift, margin)),
+        _ => Err(format!(
+            "expected a wide wall lift and a margin in [0, 1] (LIFT,MARGIN), got {s:?}"
         )),
     }
 }
@@ -407,6 +428,16 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
     let mut config = RegisterConfig::default();
     if let Some(r) = args.basin_ratio {
         config.pair.verify.basin_ratio = r;
+    }
+    if args.no_stand_out {
+        config.pair.verify.stand_out = None;
+    }
+    if let Some((lift, margin)) = args.stand_out {
+        config.pair.verify.stand_out = Some(mapmerge::verify::StandOut {
+            min_wide_wall_lift: lift,
+            margin,
+            ..Default::default()
+        });
     }
     if let Some(t) = args.wall_tolerance {
         config.pair.verify.wall_tolerance_px = t;
@@ -799,7 +830,7 @@ pub fn run(args: EvalArgs) -> Result<()> {
 
 #[cfg(test)]
 mod tests {
-    use super::{Row, angle_window, export, grey_values, slug};
+    use super::{Row, angle_window, export, grey_values, slug, stand_out_values};
     use grid_core::io::{LoadOptions, load_map};
     use mapsim::{CaseConfig, generate_case};
 
@@ -886,6 +917,16 @@ mod tests {
             angle_window("four"),
             Err("\"four\": invalid float literal".to_string())
         );
+    }
+
+    #[test]
+    fn stand_out_values_take_a_lift_and_a_margin_in_the_unit_interval() {
+        assert_eq!(stand_out_values("0.7,0.3"), Ok((0.7, 0.3)));
+        assert_eq!(stand_out_values(" 0.75 , 0.25"), Ok((0.75, 0.25)));
+        let want = "expected a wide wall lift and a margin in [0, 1] (LIFT,MARGIN), got \"0.7\"";
+        assert_eq!(stand_out_values("0.7"), Err(want.to_string()));
+        assert!(stand_out_values("0.7,NaN").is_err());
+        assert!(stand_out_values("0.7,1.5").is_err());
     }
 
     #[test]
