@@ -1,7 +1,13 @@
 //! End-to-end registration of a 2048 x 2048 real-building pair, and each stage on its own.
 //!
 //! A = the Osnabrueck CIC floor (fixtures/maps/uos_cic, 980 x 1477) on a 2048 x 2048 canvas,
-//! B = the same floor turned by 30 degrees and shifted, on another 2048 x 2048 canvas.
+//! B = the same floor turned by 30 degrees and shifted, on another 2048 x 2048 canvas: a pair
+//! whose keypoints agree, registered by RANSAC alone.
+//!
+//! `end_to_end_partial_maps`: two simulated robots' partial maps of the same floor (10 % and
+//! 20 % range noise, half of each map shared: case 7_014_000 of `cargo xtask eval --suites
+//! overlap,zero,paper,real,noise --seed 7`), each on a 2048 x 2048 canvas. Few keypoints agree
+//! there, so the global search, the rotation sweep and the symmetry probes run: the hard case.
 //! Run: `cargo bench -p mapmerge --bench register`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
@@ -9,6 +15,7 @@ use grid_core::io::{LoadOptions, load_map};
 use grid_core::{CorrespondenceSource, OccupancyGrid, Rigid2};
 use mapmerge::verify::{PreparedMap, VerifyConfig};
 use mapmerge::{RegisterConfig, register};
+use mapsim::{CaseConfig, RobotConfig, WorldConfig, WorldKind, generate_case};
 
 fn pair() -> (OccupancyGrid, OccupancyGrid) {
     let path = concat!(
@@ -25,6 +32,38 @@ fn pair() -> (OccupancyGrid, OccupancyGrid) {
     (a, b)
 }
 
+/// Two robots' partial maps of the uos_cic floor (see the module documentation), each moved
+/// onto a 2048 x 2048 canvas.
+fn partial_pair() -> (OccupancyGrid, OccupancyGrid) {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../fixtures/maps/uos_cic/uos_cic.yaml"
+    );
+    let floor = load_map(path, &LoadOptions::default()).expect("fixture loads");
+    let robot = |noise_bound| RobotConfig {
+        noise_bound,
+        ..RobotConfig::default()
+    };
+    let config = CaseConfig {
+        world: WorldConfig {
+            kind: WorldKind::Grid(floor),
+            width: 0,
+            height: 0,
+            ..WorldConfig::default()
+        },
+        robots: vec![robot(0.1), robot(0.2)],
+        overlap: 0.5,
+        overlap_tolerance: f64::INFINITY,
+        ..CaseConfig::default()
+    };
+    let case = generate_case(&config, 7_014_000).expect("case generates");
+    let canvas = |m: &OccupancyGrid| {
+        m.warp(&Rigid2::new(0.0, 300.0, 200.0), 2048, 2048)
+            .expect("canvas")
+    };
+    (canvas(&case.robots[0].map), canvas(&case.robots[1].map))
+}
+
 fn bench(c: &mut Criterion) {
     let (a, b) = pair();
     let config = RegisterConfig::default();
@@ -32,6 +71,10 @@ fn bench(c: &mut Criterion) {
     g.sample_size(10);
     g.bench_function("end_to_end", |bn| {
         bn.iter(|| register(&a, &b, &config).expect("valid config"))
+    });
+    let (pa, pb) = partial_pair();
+    g.bench_function("end_to_end_partial_maps", |bn| {
+        bn.iter(|| register(&pa, &pb, &config).expect("valid config"))
     });
     let sift = sift_desc::SiftCorrespondences::new(config.sift.clone()).expect("valid config");
     g.bench_function("sift_correspondences", |bn| {
