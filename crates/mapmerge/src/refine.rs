@@ -14,7 +14,7 @@
 use grid_core::{CellState, DVec2, Rigid2};
 use rayon::prelude::*;
 
-use crate::verify::{PreparedMap, strided};
+use crate::verify::{PreparedMap, nearest_cell, strided};
 
 /// Parameters of the refinement, with documented defaults.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -128,11 +128,9 @@ fn collect_chunk(
     let (samples, off_from) = from;
     for &(p, sp) in samples {
         let m = to_onto.apply(p + off_from * sp);
-        let (x, y) = (m.x.round(), m.y.round());
-        if x < 0.0 || y < 0.0 {
+        let Some((x, y)) = nearest_cell(m) else {
             continue;
-        }
-        let (x, y) = (x as usize, y as usize);
+        };
         if onto.grid.state(x, y) == CellState::Unknown {
             continue;
         }

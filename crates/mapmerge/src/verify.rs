@@ -190,6 +190,10 @@ pub struct PreparedMap<'a> {
     /// Per cell of the known window, the side of the wall normal on which free space lies
     /// (see [`PreparedMap::free_side`]).
     pub free_sides: Vec<i8>,
+    /// Per cell of the known window, the distance to the nearest occupied cell where the cell
+    /// is known, infinite where it is unknown: both lookups of the local search in one (see
+    /// [`PreparedMap::known_wall_distance`]).
+    known_distances: Vec<f32>,
 }
 
 /// How [`strided`] picks `max` of `len` items: how many it keeps, and the step such that pick
@@ -287,12 +291,15 @@ impl<'a> PreparedMap<'a> {
             StridedPicker::new(known_cells, config.max_samples),
             StridedPicker::new(occupied_cells, config.max_samples),
         );
-        for (y, cells, _) in rows() {
-            for (i, &c) in cells.iter().enumerate() {
+        let mut known_distances = Vec::with_capacity(ww * wh);
+        for (y, cells, dist) in rows() {
+            for (i, (&c, &d)) in cells.iter().zip(dist).enumerate() {
                 let s = OccupancyGrid::classify(c);
                 if s == CellState::Unknown {
+                    known_distances.push(f32::INFINITY);
                     continue;
                 }
+                known_distances.push(d);
                 let p = DVec2::new((x0 + i) as f64, y as f64);
                 known.offer(p);
                 if s == CellState::Occupied {
@@ -322,6 +329,7 @@ impl<'a> PreparedMap<'a> {
             wide_base_rate,
             normals,
             free_sides,
+            known_distances,
         };
         prepared.wall_sides = prepared
             .wall_samples
@@ -329,6 +337,15 @@ impl<'a> PreparedMap<'a> {
             .map(|p| prepared.free_side(p.x as usize, p.y as usize))
             .collect();
         prepared
+    }
+
+    /// Distance from known cell `(x, y)` to the nearest occupied cell; infinite where the cell
+    /// is unknown (or outside the known window) or the map has no occupied cell.
+    #[inline]
+    pub fn known_wall_distance(&self, x: usize, y: usize) -> f32 {
+        self.walls
+            .index(x, y)
+            .map_or(f32::INFINITY, |i| self.known_distances[i])
     }
 
     /// Unit normal of the wall at occupied cell `(x, y)`, if it has a clear direction.
@@ -496,9 +513,19 @@ impl Verification {
 /// The cell of `grid` holding point `q` (pixel centres at integers), if inside it.
 #[inline]
 pub(crate) fn cell_of(grid: &OccupancyGrid, q: DVec2) -> Option<(usize, usize)> {
-    let (x, y) = (q.x.round(), q.y.round());
-    (x >= 0.0 && y >= 0.0 && (x as usize) < grid.width() && (y as usize) < grid.height())
-        .then_some((x as usize, y as usize))
+    let (w, h) = (grid.width() as f64, grid.height() as f64);
+    nearest_cell(q).filter(|&(x, y)| (x as f64) < w && (y as f64) < h)
+}
+
+/// The cell nearest to point `q` (pixel centres at integers), if both coordinates round to 0
+/// or more: `floor(q + 0.5)`, by truncation once `q + 0.5` is known to be positive.
+/// `f64::round` is a library call on baseline x86-64, and the refinement, the verification
+/// and the local search look up millions of points per pair. The two agree but where `q +
+/// 0.5` rounds up to a whole number (`q` within 2^-53 below a half).
+#[inline]
+pub(crate) fn nearest_cell(q: DVec2) -> Option<(usize, usize)> {
+    let (x, y) = (q.x + 0.5, q.y + 0.5);
+    (x > 0.0 && y > 0.0).then_some((x as usize, y as usize))
 }
 
 /// Wall hits (within `tol` and within `wide`), contradictions (landing on a free cell
