@@ -96,17 +96,27 @@ impl Kernel {
 /// Sum of kernel values of `points` mapped by `t` onto `onto`'s walls (nothing where `onto`
 /// is unknown: the kernel of an infinite distance is 0).
 fn half_score(points: &[DVec2], onto: &PreparedMap, t: &Rigid2, k: &Kernel) -> f32 {
+    shifted_score(&turned(points, t.theta), onto, t.translation(), k)
+}
+
+/// [`half_score`] of points already turned by the pose's rotation ([`turned`]), for the
+/// pose's translation `shift`.
+fn shifted_score(turned: &[DVec2], onto: &PreparedMap, shift: DVec2, k: &Kernel) -> f32 {
     let (w, h) = (onto.grid.width() as f64, onto.grid.height() as f64);
-    let rot = DVec2::from_angle(t.theta);
-    let shift = t.translation();
     let mut s = 0.0;
-    for &p in points {
-        let q = rot.rotate(p) + shift;
+    for &r in turned {
+        let q = r + shift;
         if let Some((x, y)) = nearest_cell(q).filter(|&(x, y)| (x as f64) < w && (y as f64) < h) {
             s += k.at(onto.known_wall_distance(x, y));
         }
     }
     s
+}
+
+/// `points` turned by `theta`.
+fn turned(points: &[DVec2], theta: f64) -> Vec<DVec2> {
+    let rot = DVec2::from_angle(theta);
+    points.iter().map(|p| rot.rotate(*p)).collect()
 }
 
 /// The best pose near `b_to_a` (maps pixels of `b` onto `a`) by the correlative score.
@@ -157,13 +167,23 @@ pub fn local_search(
             best_score = score(&pose(best.0, best.1), false);
         }
         let coarse = level == 0;
+        let (sa, sb) = if coarse { (&ca, &cb) } else { (&pa, &pb) };
         let (theta0, d0) = best;
         for ia in -n_a..=n_a {
             let dtheta = theta0 + ia as f64 * astep;
+            // Every pose at this angle turns the points alike (a pose's angle does not depend
+            // on its translation): turn them once, then only shift them per pose.
+            let at_angle = pose(dtheta, d0);
+            let (tb, ta) = (
+                turned(sb, at_angle.theta),
+                turned(sa, at_angle.inverse().theta),
+            );
             for iy in -n_t..=n_t {
                 for ix in -n_t..=n_t {
                     let d = d0 + DVec2::new(ix as f64, iy as f64) * step;
-                    let s = score(&pose(dtheta, d), coarse);
+                    let t = pose(dtheta, d);
+                    let s = shifted_score(&tb, a, t.translation(), &kernel)
+                        + shifted_score(&ta, b, t.inverse().translation(), &kernel);
                     // Strictly better only: on a plateau the hypothesis (or the earlier pose)
                     // stays, which keeps the result independent of the grid's visiting order.
                     if s > best_score {
