@@ -3,7 +3,7 @@
 //! (`VerifyConfig::basin_ratio`) and the stand-out rule of acceptance (`VerifyConfig::stand_out`).
 
 use grid_core::metrics::displacement_error;
-use mapmerge::{RegisterConfig, register};
+use mapmerge::{RegisterConfig, Registration, register};
 use mapsim::{
     Case, CaseConfig, InverseSensorModel, RobotConfig, WorldConfig, WorldKind, generate_case,
 };
@@ -33,18 +33,25 @@ fn disaster_case(seed: u64, overlap: f64, noise: f64, model: InverseSensorModel)
     generate_case(&config, seed).unwrap()
 }
 
+/// The pair of `case` (robot 1 onto robot 0) registered with `config`, and the accepted
+/// answer's displacement error in pixels, if any.
+fn registered(case: &Case, config: &RegisterConfig) -> (Registration, Option<f64>) {
+    let (a, b) = (&case.robots[0].map, &case.robots[1].map);
+    let r = register(a, b, config).unwrap();
+    let error = r
+        .accepted
+        .as_ref()
+        .map(|c| displacement_error(b, &c.transform, &case.truth(0, 1)).unwrap());
+    (r, error)
+}
+
 /// Case `seed` of the disaster 30 % overlap row of `cargo xtask eval` (10 % range noise, the
 /// default mapper; seeds 7_000_000 + k come from `--suites overlap,zero,paper,real,noise
 /// --seed 7`, 3_000_000 + k from `--suites overlap --only "overlap 0.3" --seed 3`): registered
 /// with `config`, the accepted answer's displacement error in pixels, if any.
 fn disaster_30_error(seed: u64, config: &RegisterConfig) -> Option<f64> {
     let case = disaster_case(seed, 0.3, 0.1, InverseSensorModel::default());
-    let (a, b) = (&case.robots[0].map, &case.robots[1].map);
-    let truth = case.truth(0, 1);
-    register(a, b, config)
-        .unwrap()
-        .accepted
-        .map(|c| displacement_error(b, &c.transform, &truth).unwrap())
+    registered(&case, config).1
 }
 
 /// The sweep as it was before `SweepConfig::translation_peaks` and `screened`: one
@@ -122,14 +129,7 @@ fn a_disaster_pair_at_30_percent_overlap_is_registered_after_the_screen() {
 #[test]
 fn a_rival_in_the_best_placements_basin_does_not_make_the_pair_ambiguous() {
     let case = disaster_case(7_001_019, 0.5, 0.3, InverseSensorModel::hector());
-    let (a, b) = (&case.robots[0].map, &case.robots[1].map);
-    let truth = case.truth(0, 1);
-
-    let with = register(a, b, &RegisterConfig::default()).unwrap();
-    let error = with
-        .accepted
-        .as_ref()
-        .map(|c| displacement_error(b, &c.transform, &truth).unwrap());
+    let (with, error) = registered(&case, &RegisterConfig::default());
     assert!(
         error.is_some_and(|e| e <= 3.0),
         "with the basin rule: {error:?} px ({:?})",
@@ -138,7 +138,7 @@ fn a_rival_in_the_best_placements_basin_does_not_make_the_pair_ambiguous() {
 
     let mut without = RegisterConfig::default();
     without.pair.verify.basin_ratio = 0.0;
-    let reason = register(a, b, &without).unwrap().reason.unwrap_or_default();
+    let reason = registered(&case, &without).0.reason.unwrap_or_default();
     assert!(
         reason.starts_with("ambiguous: two different placements fit almost equally well"),
         "without the basin rule the pair should be declined as ambiguous: {reason:?}"
@@ -153,21 +153,16 @@ fn a_rival_in_the_best_placements_basin_does_not_make_the_pair_ambiguous() {
 #[test]
 fn a_placement_that_stands_out_on_speckled_walls_is_accepted() {
     let case = disaster_case(7_003_000, 0.5, 0.3, InverseSensorModel::hector());
-    let (a, b) = (&case.robots[0].map, &case.robots[1].map);
-    let truth = case.truth(0, 1);
-
-    let with = register(a, b, &RegisterConfig::default()).unwrap();
-    let answer = with.accepted.as_ref();
-    let error = answer.map(|c| displacement_error(b, &c.transform, &truth).unwrap());
+    let (with, error) = registered(&case, &RegisterConfig::default());
     assert!(
-        error.is_some_and(|e| e <= 3.0) && answer.is_some_and(|c| c.stands_out),
+        error.is_some_and(|e| e <= 3.0) && with.accepted.is_some_and(|c| c.stands_out),
         "with the stand-out rule: {error:?} px ({:?})",
         with.reason
     );
 
     let mut without = RegisterConfig::default();
     without.pair.verify.stand_out = None;
-    let reason = register(a, b, &without).unwrap().reason.unwrap_or_default();
+    let reason = registered(&case, &without).0.reason.unwrap_or_default();
     assert!(
         reason.starts_with("no hypothesis passed verification"),
         "without the stand-out rule the pair should be declined: {reason:?}"
