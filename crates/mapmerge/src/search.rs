@@ -29,7 +29,7 @@
 
 use grid_core::{DVec2, Rigid2};
 
-use crate::verify::{PreparedMap, nearest_cell, strided};
+use crate::verify::{PreparedMap, cell_of, strided};
 
 /// The search window and grid, with documented defaults.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -102,11 +102,9 @@ fn half_score(points: &[DVec2], onto: &PreparedMap, t: &Rigid2, k: &Kernel) -> f
 /// [`half_score`] of points already turned by the pose's rotation ([`turned`]), for the
 /// pose's translation `shift`.
 fn shifted_score(turned: &[DVec2], onto: &PreparedMap, shift: DVec2, k: &Kernel) -> f32 {
-    let (w, h) = (onto.grid.width() as f64, onto.grid.height() as f64);
     let mut s = 0.0;
     for &r in turned {
-        let q = r + shift;
-        if let Some((x, y)) = nearest_cell(q).filter(|&(x, y)| (x as f64) < w && (y as f64) < h) {
+        if let Some((x, y)) = cell_of(onto.grid, r + shift) {
             s += k.at(onto.known_wall_distance(x, y));
         }
     }
