@@ -51,6 +51,10 @@ pub struct EvalArgs {
     /// Skip the symmetry probes of the best candidate (to measure what they add).
     #[arg(long)]
     no_symmetry: bool,
+    /// Skip the global search (Hough spectrum and correlation) that runs when no feature-based
+    /// candidate passed, leaving the rotation sweep (to measure what it adds).
+    #[arg(long)]
+    no_global: bool,
     /// Score candidates without their range-bias offsets (to measure what they add).
     #[arg(long)]
     no_offset_scoring: bool,
@@ -447,6 +451,9 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
     }
     if args.no_symmetry {
         config.pair.symmetry_probes = false;
+    }
+    if args.no_global {
+        config.pair.global = None;
     }
     if args.no_search {
         config.pair.search = None;
