@@ -196,10 +196,7 @@ fn angle_window(s: &str) -> Result<f64, String> {
 
 /// Three grey values in `[0, 1]`, comma-separated (`--sift-mapping`).
 fn grey_values(s: &str) -> Result<[f32; 3], String> {
-    let v: Vec<f32> = s
-        .split(',')
-        .map(|x| x.trim().parse::<f32>().map_err(|e| format!("{x:?}: {e}")))
-        .collect::<Result<_, _>>()?;
+    let v: Vec<f32> = numbers(s)?;
     match v.as_slice() {
         &[f, o, u] if v.iter().all(|g| (0.0..=1.0).contains(g)) => Ok([f, o, u]),
         _ => Err(format!(
@@ -208,12 +205,20 @@ fn grey_values(s: &str) -> Result<[f32; 3], String> {
     }
 }
 
+/// Comma-separated numbers; an error names the one that does not parse.
+fn numbers<T>(s: &str) -> Result<Vec<T>, String>
+where
+    T: std::str::FromStr,
+    T::Err: std::fmt::Display,
+{
+    s.split(',')
+        .map(|x| x.trim().parse::<T>().map_err(|e| format!("{x:?}: {e}")))
+        .collect()
+}
+
 /// `--stand-out LIFT,MARGIN`: two numbers in [0, 1].
 fn stand_out_values(s: &str) -> Result<(f64, f64), String> {
-    let v: Vec<f64> = s
-        .split(',')
-        .map(|x| x.trim().parse::<f64>().map_err(|e| format!("{x:?}: {e}")))
-        .collect::<Result<_, _>>()?;
+    let v: Vec<f64> = numbers(s)?;
     match v.as_slice() {
         &[lift, margin] if v.iter().all(|g| (0.0..=1.0).contains(g)) => Ok((lift, margin)),
         _ => Err(format!(

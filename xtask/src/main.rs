@@ -15,17 +15,18 @@ struct Cli {
     command: Command,
 }
 
+// The arguments are boxed: their many flags make the variants large and of unequal size.
 #[derive(Subcommand)]
 enum Command {
     /// Generate simulated robot-team cases (partial maps with known truth).
-    Gen(r#gen::Args),
+    Gen(Box<r#gen::Args>),
     /// Measure registration accuracy, decline rate and time on regenerable simulated suites.
-    Eval(eval::EvalArgs),
+    Eval(Box<eval::EvalArgs>),
 }
 
 fn main() -> anyhow::Result<()> {
     match Cli::parse().command {
-        Command::Gen(args) => r#gen::run(args),
-        Command::Eval(args) => eval::run(args),
+        Command::Gen(args) => r#gen::run(*args),
+        Command::Eval(args) => eval::run(*args),
     }
 }
