@@ -156,28 +156,49 @@ fn coarse_field(
     (spread, known)
 }
 
-fn fft2(data: &mut [Complex32], w: usize, h: usize, planner: &mut FftPlanner<f32>, inverse: bool) {
-    let row = if inverse {
-        planner.plan_fft_inverse(w)
-    } else {
-        planner.plan_fft_forward(w)
-    };
-    for r in data.chunks_mut(w) {
-        row.process(r);
-    }
-    let col = if inverse {
-        planner.plan_fft_inverse(h)
-    } else {
-        planner.plan_fft_forward(h)
-    };
-    let mut buf = vec![Complex32::default(); h];
-    for x in 0..w {
-        for y in 0..h {
-            buf[y] = data[y * w + x];
+/// Two-dimensional FFT of the row-major `w x h` image `data`, in place: every row, then
+/// every column. Rows at and beyond `rows` must be zero (their transforms are zero and are
+/// skipped). Columns are gathered into a contiguous block a batch at a time, so that each
+/// transform reads contiguous memory, and all transforms share one scratch buffer; each
+/// transform is the same as one done alone, so the result does not depend on the batching.
+fn fft2(
+    data: &mut [Complex32],
+    (w, h): (usize, usize),
+    rows: usize,
+    planner: &mut FftPlanner<f32>,
+    inverse: bool,
+) {
+    let mut plan = |n| {
+        if inverse {
+            planner.plan_fft_inverse(n)
+        } else {
+            planner.plan_fft_forward(n)
         }
-        col.process(&mut buf);
+    };
+    let (row, col) = (plan(w), plan(h));
+    let mut scratch = vec![
+        Complex32::default();
+        row.get_inplace_scratch_len()
+            .max(col.get_inplace_scratch_len())
+    ];
+    let rows = rows.min(h);
+    if rows > 0 {
+        row.process_with_scratch(&mut data[..rows * w], &mut scratch);
+    }
+    const BATCH: usize = 16;
+    let mut block = vec![Complex32::default(); BATCH * h];
+    for x0 in (0..w).step_by(BATCH) {
+        let k = BATCH.min(w - x0);
         for y in 0..h {
-            data[y * w + x] = buf[y];
+            for j in 0..k {
+                block[j * h + y] = data[y * w + x0 + j];
+            }
+        }
+        col.process_with_scratch(&mut block[..k * h], &mut scratch);
+        for y in 0..h {
+            for j in 0..k {
+                data[y * w + x0 + j] = block[j * h + y];
+            }
         }
     }
 }
@@ -233,7 +254,7 @@ impl CoarseField {
             }
         }
         // Both transforms at once: F_A + i K_A, two real images.
-        fft2(&mut spectrum, nw, nh, planner, false);
+        fft2(&mut spectrum, (nw, nh), ch, planner, false);
         let normalization = normalized.then(|| {
             let vals: Vec<f64> = field
                 .iter()
@@ -276,20 +297,21 @@ impl CoarseField {
             .fold(DVec2::splat(f64::INFINITY), DVec2::min);
         buf.clear();
         buf.resize(nw * nh, Complex32::default());
-        let mut cells = 0usize;
+        let (mut cells, mut rows) = (0usize, 0usize);
         for p in &q {
             let u = (*p - qmin) / scale;
             let (ux, uy) = (u.x.round() as usize, u.y.round() as usize);
             if ux < nw && uy < nh && buf[uy * nw + ux].re == 0.0 {
                 buf[uy * nw + ux].re = 1.0;
                 cells += 1;
+                rows = rows.max(uy + 1);
             }
         }
-        fft2(buf, nw, nh, planner, false);
+        fft2(buf, (nw, nh), rows, planner, false);
         for (x, y) in buf.iter_mut().zip(&self.spectrum) {
             *x = y * x.conj();
         }
-        fft2(buf, nw, nh, planner, true);
+        fft2(buf, (nw, nh), nh, planner, true);
         // B's image is real, so the real part is C(t) and, for a normalised field, the
         // imaginary part N(t): how many of B's wall cells land on known cells of A (both scaled
         // by the image size, the inverse FFT being unnormalised).
@@ -339,29 +361,50 @@ impl CoarseField {
 /// The best `peaks` positive local maxima `(value, x, y)` of the `w x h` image `score` (its
 /// borders wrapped around), highest first.
 fn local_maxima(score: &[f32], w: usize, h: usize, peaks: usize) -> Vec<(f32, usize, usize)> {
-    let mut found: Vec<(f32, usize, usize)> = Vec::new();
+    // The best so far, highest first; among equal values, first found first (a stable sort
+    // of all maxima, truncated, gives the same).
+    let mut found: Vec<(f32, usize, usize)> = Vec::with_capacity(peaks + 1);
+    if peaks == 0 {
+        return found;
+    }
+    let wrap = |t: usize, d: i64, n: usize| (t as i64 + d).rem_euclid(n as i64) as usize;
     for ty in 0..h {
+        let inner_row = ty > 0 && ty + 1 < h;
         for tx in 0..w {
             let v = score[ty * w + tx];
-            if v <= 0.0 {
+            // Only a value above the worst kept can enter (ties keep the earlier one).
+            if v <= 0.0 || (found.len() == peaks && v <= found[peaks - 1].0) {
                 continue;
             }
-            let is_max = (-1i64..=1).all(|dy| {
-                (-1i64..=1).all(|dx| {
-                    let (nx, ny) = (
-                        (tx as i64 + dx).rem_euclid(w as i64),
-                        (ty as i64 + dy).rem_euclid(h as i64),
-                    );
-                    (dx == 0 && dy == 0) || score[ny as usize * w + nx as usize] <= v
+            let is_max = if inner_row && tx > 0 && tx + 1 < w {
+                // Away from the borders the neighbours need no wrapping.
+                let i = ty * w + tx;
+                [
+                    i - w - 1,
+                    i - w,
+                    i - w + 1,
+                    i - 1,
+                    i + 1,
+                    i + w - 1,
+                    i + w,
+                    i + w + 1,
+                ]
+                .iter()
+                .all(|&j| score[j] <= v)
+            } else {
+                (-1i64..=1).all(|dy| {
+                    (-1i64..=1).all(|dx| {
+                        (dx == 0 && dy == 0) || score[wrap(ty, dy, h) * w + wrap(tx, dx, w)] <= v
+                    })
                 })
-            });
+            };
             if is_max {
-                found.push((v, tx, ty));
+                let at = found.partition_point(|f| f.0 >= v);
+                found.insert(at, (v, tx, ty));
+                found.truncate(peaks);
             }
         }
     }
-    found.sort_by(|x, y| y.0.total_cmp(&x.0));
-    found.truncate(peaks);
     found
 }
 
