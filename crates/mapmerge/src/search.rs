@@ -29,7 +29,7 @@
 
 use grid_core::{DVec2, Rigid2};
 
-use crate::verify::{PreparedMap, cell_of, strided};
+use crate::verify::{PreparedMap, UNKNOWN_QUARTERS, strided};
 
 /// The search window and grid, with documented defaults.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -86,10 +86,14 @@ impl Kernel {
         Self { table }
     }
 
+    /// The kernel at a distance in quarter pixels ([`PreparedMap::known_wall_quarters`]);
+    /// zero for an unknown cell.
     #[inline]
-    fn at(&self, d: f32) -> f32 {
-        let i = (d * 4.0) as usize;
-        self.table.get(i).copied().unwrap_or(0.0)
+    fn at(&self, quarters: u16) -> f32 {
+        if quarters == UNKNOWN_QUARTERS {
+            return 0.0;
+        }
+        self.table.get(quarters as usize).copied().unwrap_or(0.0)
     }
 }
 
@@ -104,9 +108,7 @@ fn half_score(points: &[DVec2], onto: &PreparedMap, t: &Rigid2, k: &Kernel) -> f
 fn shifted_score(turned: &[DVec2], onto: &PreparedMap, shift: DVec2, k: &Kernel) -> f32 {
     let mut s = 0.0;
     for &r in turned {
-        if let Some((x, y)) = cell_of(onto.grid, r + shift) {
-            s += k.at(onto.known_wall_distance(x, y));
-        }
+        s += k.at(onto.known_wall_quarters(r + shift));
     }
     s
 }
