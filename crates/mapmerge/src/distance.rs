@@ -152,6 +152,20 @@ impl NearestOccupied {
         })
     }
 
+    /// [`Self::nearest`] by window index ([`Self::index`]): the nearest occupied cell's window
+    /// index and its distance; `None` when the grid has no occupied cell.
+    #[inline]
+    pub(crate) fn nearest_at(&self, i: usize) -> Option<(usize, f32)> {
+        let site = self.nearest[i];
+        (site != NONE).then(|| (site as usize, self.distance[i]))
+    }
+
+    /// Grid cell `(x, y)` of window index `i` (the inverse of [`Self::index`]).
+    #[inline]
+    pub(crate) fn cell(&self, i: usize) -> (usize, usize) {
+        (self.x0 + i % self.width, self.y0 + i / self.width)
+    }
+
     /// The distances of the window's cells, row by row (the layout of [`Self::window`]).
     pub(crate) fn distances(&self) -> &[f32] {
         &self.distance

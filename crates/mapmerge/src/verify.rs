@@ -161,6 +161,47 @@ impl Default for VerifyConfig {
     }
 }
 
+/// [`PreparedMap::wall_lookup`] of one window cell: the wall cell nearest to it (`wall`) and
+/// its `distance` (infinite where the cell is unknown or the map has no wall), the wall's
+/// `normal` (NaN where it has no clear direction) and free `side`, as
+/// [`PreparedMap::normal_and_side`] gives them. Small and plain, so that the refinement can
+/// keep one per wall sample between its iterations and look the map up again only where a
+/// sample moved to another cell.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct WallLookup {
+    /// The window index looked up; `u32::MAX` (never a window index) for none yet.
+    pub index: u32,
+    pub wall: [u32; 2],
+    pub distance: f32,
+    pub normal: [f32; 2],
+    pub side: i8,
+}
+
+impl WallLookup {
+    /// No lookup yet, or no wall.
+    pub const NONE: Self = Self {
+        index: u32::MAX,
+        wall: [0, 0],
+        distance: f32::INFINITY,
+        normal: [f32::NAN, f32::NAN],
+        side: 0,
+    };
+
+    /// Whether a wall was found: the cell is known and the map has one.
+    #[inline]
+    pub fn has_wall(&self) -> bool {
+        self.distance != f32::INFINITY
+    }
+
+    /// The wall's unit normal and free side, if it has a clear direction (as
+    /// [`PreparedMap::normal_and_side`]).
+    #[inline]
+    pub fn normal_and_side(&self) -> Option<(DVec2, f64)> {
+        let [nx, ny] = self.normal;
+        (!nx.is_nan()).then(|| (DVec2::new(nx as f64, ny as f64), self.side as f64))
+    }
+}
+
 /// [`PreparedMap::known_wall_quarters`] of an unknown cell.
 pub const UNKNOWN_QUARTERS: u16 = u16::MAX;
 
@@ -355,6 +396,36 @@ impl<'a> PreparedMap<'a> {
             .map_or(UNKNOWN_QUARTERS, |i| self.known_quarters[i])
     }
 
+    /// Window index ([`NearestOccupied::index`]) of the cell nearest to point `q`, if that cell
+    /// lies in the known window.
+    #[inline]
+    pub(crate) fn window_index(&self, q: DVec2) -> Option<usize> {
+        nearest_cell(q).and_then(|(x, y)| self.walls.index(x, y))
+    }
+
+    /// What the refinement's pairing needs of window cell `i` ([`Self::window_index`]): the
+    /// nearest wall cell, its distance, normal and free side (see [`WallLookup`]).
+    #[inline]
+    pub(crate) fn wall_lookup(&self, i: usize) -> WallLookup {
+        let found = (self.known_quarters[i] != UNKNOWN_QUARTERS)
+            .then(|| self.walls.nearest_at(i))
+            .flatten();
+        let Some((site, distance)) = found else {
+            return WallLookup {
+                index: i as u32,
+                ..WallLookup::NONE
+            };
+        };
+        let (x, y) = self.walls.cell(site);
+        WallLookup {
+            index: i as u32,
+            wall: [x as u32, y as u32],
+            distance,
+            normal: self.normals[site],
+            side: self.free_sides[site],
+        }
+    }
+
     /// Unit normal of the wall at occupied cell `(x, y)`, if it has a clear direction.
     #[inline]
     pub fn normal(&self, x: usize, y: usize) -> Option<DVec2> {
@@ -532,7 +603,9 @@ pub(crate) fn cell_of(grid: &OccupancyGrid, q: DVec2) -> Option<(usize, usize)> 
 #[inline]
 pub(crate) fn nearest_cell(q: DVec2) -> Option<(usize, usize)> {
     let (x, y) = (q.x + 0.5, q.y + 0.5);
-    (x > 0.0 && y > 0.0).then_some((x as usize, y as usize))
+    // Through i64, a single instruction (f64 to u64 takes a branch and two): the same cell
+    // below 2^63, and beyond it a cell past any map's side either way.
+    (x > 0.0 && y > 0.0).then_some((x as i64 as usize, y as i64 as usize))
 }
 
 /// Wall hits (within `tol` and within `wide`), contradictions (landing on a free cell
