@@ -564,7 +564,7 @@ pub fn register_with(
         }
     };
     let mut candidates: Vec<Candidate> = hypotheses
-        .iter()
+        .par_iter()
         .map(|h| Candidate {
             ransac_inliers: h.inliers_count,
             ransac_confidence: h.confidence,
@@ -578,8 +578,10 @@ pub fn register_with(
         let t0 = Instant::now();
         let mut models = Vec::new();
         generate(&mut models);
+        // Side by side: a check's own polishes are unequal (the turn search is the longest),
+        // so one check alone leaves a core idle. Collected in order, as a sequential map would.
         let found: Vec<Candidate> = models
-            .iter()
+            .par_iter()
             .map(|m| check(m, &config.global_refine, origin))
             .collect();
         (found, ms(t0))
