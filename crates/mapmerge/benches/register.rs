@@ -8,13 +8,25 @@
 //! 20 % range noise, half of each map shared: case 7_014_000 of `cargo xtask eval --suites
 //! overlap,zero,paper,real,noise --seed 7`), each on a 2048 x 2048 canvas. Few keypoints agree
 //! there, so the global search, the rotation sweep and the symmetry probes run: the hard case.
+//!
+//! `partial_maps/*`: the stages that dominate that hard pair, each on its own, on the same
+//! pair prepared once: the rotation sweep (`sweep_placements`), the Hough-spectrum and
+//! correlation search (`global_hypotheses`), one correlative local search over +-2 degrees
+//! (the turn search each whole-map placement gets), one refinement and scoring of a
+//! placement (`refine_and_score`: ICP with the range-bias offsets, then verification) and one
+//! verification alone. The end-to-end time is about one sweep and one global search plus a
+//! few dozen placements each searched, refined and scored (see `timings_ms` of
+//! `mapmerge estimate --json`).
+//!
 //! Run: `cargo bench -p mapmerge --bench register`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use grid_core::io::{LoadOptions, load_map};
 use grid_core::{CorrespondenceSource, OccupancyGrid, Rigid2};
-use mapmerge::verify::{PreparedMap, VerifyConfig};
-use mapmerge::{RegisterConfig, register};
+use mapmerge::global::{global_hypotheses, sweep_placements};
+use mapmerge::search::local_search;
+use mapmerge::verify::{PreparedMap, VerifyConfig, verify};
+use mapmerge::{RegisterConfig, refine_and_score, register};
 use mapsim::{CaseConfig, RobotConfig, WorldConfig, WorldKind, generate_case};
 
 fn pair() -> (OccupancyGrid, OccupancyGrid) {
@@ -102,6 +114,46 @@ fn bench(c: &mut Criterion) {
                 PreparedMap::new(&b, &VerifyConfig::default()).known_cells,
             )
         })
+    });
+    g.finish();
+
+    // The hard pair's stages, on the maps prepared as `register` prepares them.
+    let pair_config = &config.pair;
+    let (ppa, ppb) = (
+        PreparedMap::new(&pa, &pair_config.verify),
+        PreparedMap::new(&pb, &pair_config.verify),
+    );
+    let sweep = pair_config.sweep.expect("the default runs the sweep");
+    let global = pair_config
+        .global
+        .expect("the default runs the global search");
+    let turn = pair_config
+        .turn_search
+        .expect("the default searches whole-map placements over rotation");
+    let normalized = sweep.screened.max(sweep.keep_normalized);
+    // A placement as the sweep proposes it: where the local search, ICP and verification
+    // start for every whole-map candidate.
+    let start = sweep_placements(&ppa, &ppb, &sweep, normalized).plain[0];
+    let mut g = c.benchmark_group("partial_maps");
+    g.sample_size(10);
+    g.bench_function("rotation_sweep", |bn| {
+        bn.iter(|| sweep_placements(&ppa, &ppb, &sweep, normalized))
+    });
+    g.bench_function("global_search", |bn| {
+        bn.iter(|| {
+            let mut out = Vec::new();
+            global_hypotheses(&ppa, &ppb, &global, &mut out);
+            out
+        })
+    });
+    g.bench_function("turn_search_one_placement", |bn| {
+        bn.iter(|| local_search(&ppa, &ppb, &start, &turn))
+    });
+    g.bench_function("refine_and_score_one_placement", |bn| {
+        bn.iter(|| refine_and_score(&ppa, &ppb, &start, &pair_config.global_refine, pair_config))
+    });
+    g.bench_function("verify_one_placement", |bn| {
+        bn.iter(|| verify(&ppa, &ppb, &start, &pair_config.verify))
     });
     g.finish();
 }
