@@ -243,6 +243,8 @@ pub fn refine_with_bias(
     };
     let (wa, wb) = (sided(a), sided(b));
     let mut pairs = Vec::with_capacity(wa.len() + wb.len());
+    // One lookup per wall sample, kept between iterations: B's samples in A (`looked_a`),
+    // A's in B (`looked_b`).
     let (mut looked_a, mut looked_b) = (
         vec![WallLookup::NONE; wb.len()],
         vec![WallLookup::NONE; wa.len()],
