@@ -140,16 +140,7 @@ impl NearestOccupied {
     #[inline]
     pub fn nearest(&self, x: usize, y: usize) -> Option<((usize, usize), f32)> {
         let i = self.index(x, y)?;
-        let site = self.nearest[i];
-        (site != NONE).then(|| {
-            (
-                (
-                    self.x0 + site as usize % self.width,
-                    self.y0 + site as usize / self.width,
-                ),
-                self.distance[i],
-            )
-        })
+        self.nearest_at(i).map(|(site, d)| (self.cell(site), d))
     }
 
     /// [`Self::nearest`] by window index ([`Self::index`]): the nearest occupied cell's window

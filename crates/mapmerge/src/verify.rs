@@ -197,9 +197,15 @@ impl WallLookup {
     /// [`PreparedMap::normal_and_side`]).
     #[inline]
     pub fn normal_and_side(&self) -> Option<(DVec2, f64)> {
-        let [nx, ny] = self.normal;
-        (!nx.is_nan()).then(|| (DVec2::new(nx as f64, ny as f64), self.side as f64))
+        normal_and_side(self.normal, self.side)
     }
+}
+
+/// A stored wall normal (NaN where the wall has no clear direction) and free side, as the
+/// refinement uses them.
+#[inline]
+fn normal_and_side([nx, ny]: [f32; 2], side: i8) -> Option<(DVec2, f64)> {
+    (!nx.is_nan()).then(|| (DVec2::new(nx as f64, ny as f64), side as f64))
 }
 
 /// [`PreparedMap::known_wall_quarters`] of an unknown cell.
@@ -391,8 +397,7 @@ impl<'a> PreparedMap<'a> {
     #[inline]
     pub fn known_wall_quarters(&self, q: DVec2) -> u16 {
         // The known window lies inside the map, so its test is the map's too.
-        nearest_cell(q)
-            .and_then(|(x, y)| self.walls.index(x, y))
+        self.window_index(q)
             .map_or(UNKNOWN_QUARTERS, |i| self.known_quarters[i])
     }
 
@@ -437,8 +442,7 @@ impl<'a> PreparedMap<'a> {
     #[inline]
     pub fn normal_and_side(&self, x: usize, y: usize) -> Option<(DVec2, f64)> {
         let i = self.walls.index(x, y)?;
-        let [nx, ny] = self.normals[i];
-        (!nx.is_nan()).then(|| (DVec2::new(nx as f64, ny as f64), self.free_sides[i] as f64))
+        normal_and_side(self.normals[i], self.free_sides[i])
     }
 
     /// Unit normal of the wall at occupied cell `(x, y)` pointing to its free side: zero when
