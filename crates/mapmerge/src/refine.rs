@@ -89,150 +89,19 @@ struct Pair {
     n: DVec2,
 }
 
-/// How far (pixels) the wall samples may move from the pose their near set was picked at
-/// before it is picked again (see [`Samples`]).
-const NEAR_SLACK_PX: f64 = 2.0;
-
-/// A point and the centre of its cell are at most half a cell's diagonal apart, so the centres
-/// of two points' cells are at most the points' distance plus a diagonal apart: `sqrt(2)`, with
-/// room for the rounding of the stored f32 distances.
-const CELL_SLACK_PX: f32 = 1.5;
-
-/// The near set is picked again once the gate has shrunk by this much (pixels) since, to
-/// keep it small while the gate schedule runs.
-const GATE_STEP_PX: f32 = 1.0;
-
-/// One map's wall samples as ICP reads them: each with its free side, and the lookup it last
-/// made in the other map (kept between iterations: a sample that lands in the same cell again
-/// reuses it instead of reading the map, a cache miss each on a large map).
-///
-/// Many samples of a partial map lie far from every wall of the other map, and stay far while
-/// the pose settles. `near` holds the others, picked at some pose: every sample whose cell
-/// was within `gate + NEAR_SLACK_PX + CELL_SLACK_PX` of a wall there, or off the other map's
-/// known window. While no sample can have moved [`NEAR_SLACK_PX`] from that pose, and the gate
-/// has not shrunk by [`GATE_STEP_PX`], only they are looked up. A sample set aside is still
-/// farther than the gate from every wall (the distance transform is 1-Lipschitz between cell
-/// centres, and the gate schedule never widens), so it would not have paired: the pairs are
-/// exactly those of a pass over every sample, in the same order.
-struct Samples {
-    all: Vec<(DVec2, DVec2)>,
-    looked: Vec<WallLookup>,
-    /// Centre of the samples, and their largest distance from it.
-    centre: DVec2,
-    radius: f64,
-    near: Option<Near>,
-    /// Scratch flags of a pass over the near set (not read).
-    flags: Vec<bool>,
-}
-
-/// The samples of [`Samples`] that may still pair, with their lookups, and the pose, offset and
-/// gate they were picked at.
-struct Near {
-    indices: Vec<u32>,
-    samples: Vec<(DVec2, DVec2)>,
-    looked: Vec<WallLookup>,
-    to_onto: Rigid2,
-    offset: f64,
-    gate: f32,
-}
-
-impl Samples {
-    fn new(all: Vec<(DVec2, DVec2)>) -> Self {
-        let centre = all.iter().map(|(p, _)| *p).sum::<DVec2>() / all.len().max(1) as f64;
-        let radius = all
-            .iter()
-            .map(|(p, _)| (*p - centre).length())
-            .fold(0.0, f64::max);
-        Self {
-            looked: vec![WallLookup::NONE; all.len()],
-            flags: vec![false; all.len()],
-            all,
-            centre,
-            radius,
-            near: None,
-        }
-    }
-
-    /// Collect pairs of these samples (moved by `offset` along their free sides) with the
-    /// nearest walls of `onto`, `to_onto` mapping their pixels to `onto`'s (see [`collect`]).
-    fn collect(
-        &mut self,
-        offset: f64,
-        onto: &PreparedMap,
-        to_onto: &Rigid2,
-        gate: f32,
-        swap: Option<&Rigid2>,
-        out: &mut Vec<Pair>,
-    ) {
-        if let Some(near) = &mut self.near {
-            // How far any sample can have moved since the near set was picked: the turn about
-            // the centre, the centre's shift and the change of offset.
-            let turn = 2.0 * ((to_onto.theta - near.to_onto.theta) / 2.0).sin().abs();
-            let moved = turn * (self.radius + near.offset)
-                + (to_onto.apply(self.centre) - near.to_onto.apply(self.centre)).length()
-                + (offset - near.offset).abs();
-            if moved < NEAR_SLACK_PX && gate <= near.gate && near.gate - gate < GATE_STEP_PX {
-                let flags = &mut self.flags[..near.samples.len()];
-                let near_samples = (near.samples.as_slice(), offset);
-                collect(
-                    near_samples,
-                    onto,
-                    to_onto,
-                    (gate, f32::INFINITY),
-                    swap,
-                    (&mut near.looked, flags),
-                    out,
-                );
-                return;
-            }
-        }
-        // A pass over every sample, which picks the near set again; the near set's lookups go
-        // back first.
-        if let Some(near) = self.near.take() {
-            for (&i, l) in near.indices.iter().zip(near.looked) {
-                self.looked[i as usize] = l;
-            }
-        }
-        let limit = gate + NEAR_SLACK_PX as f32 + CELL_SLACK_PX;
-        collect(
-            (&self.all, offset),
-            onto,
-            to_onto,
-            (gate, limit),
-            swap,
-            (&mut self.looked, &mut self.flags),
-            out,
-        );
-        let indices: Vec<u32> = (0..self.all.len() as u32)
-            .filter(|&i| self.flags[i as usize])
-            .collect();
-        self.near = Some(Near {
-            samples: indices.iter().map(|&i| self.all[i as usize]).collect(),
-            looked: indices.iter().map(|&i| self.looked[i as usize]).collect(),
-            indices,
-            to_onto: *to_onto,
-            offset,
-            gate,
-        });
-    }
-}
-
 /// Collect pairs of `from`'s walls with the nearest walls of `onto`, `to_onto` mapping `from`'s
-/// pixels to `onto`'s, within `gate` of `(gate, limit)`. With `swap`, the pair is expressed the
-/// other way round (A point as target, B point as source) so both directions feed one system
-/// in A's frame. Of `(looked, near)`, `looked` holds one lookup per sample of `from`, kept
-/// from the previous iteration: a sample that lands in the same cell of `onto` again reuses it
-/// instead of reading `onto`'s arrays (a cache miss each on a large map; between iterations
-/// most samples stay in their cell). `near` gets, per sample, whether its cell lies within
-/// `limit` of a wall of `onto` or off `onto`'s known window (with an infinite `limit` it is
-/// left as it is, and nothing more is read).
+/// pixels to `onto`'s. With `swap`, the pair is expressed the other way round (A point as
+/// target, B point as source) so both directions feed one system in A's frame. `looked` holds
+/// one lookup per sample of `from`, kept from the previous iteration: a sample that lands in
+/// the same cell of `onto` again reuses it instead of reading `onto`'s arrays (a cache miss
+/// each on a large map; between iterations most samples stay in their cell).
 fn collect(
     from: (&[(DVec2, DVec2)], f64),
     onto: &PreparedMap,
     to_onto: &Rigid2,
-    (gate, limit): (f32, f32),
+    gate: f32,
     swap: Option<&Rigid2>,
-    (looked, near): (&mut [WallLookup], &mut [bool]),
+    looked: &mut [WallLookup],
     out: &mut Vec<Pair>,
 ) {
     let (from, off_from) = from;
@@ -241,16 +110,15 @@ fn collect(
     let chunks: Vec<Vec<Pair>> = from
         .par_chunks(2048)
         .zip(looked.par_chunks_mut(2048))
-        .zip(near.par_chunks_mut(2048))
-        .map(|((chunk, looked), near)| {
+        .map(|(chunk, looked)| {
             let mut part = Vec::with_capacity(chunk.len());
             collect_chunk(
                 (chunk, off_from),
                 onto,
                 to_onto,
-                (gate, limit),
+                gate,
                 swap,
-                (looked, near),
+                looked,
                 &mut part,
             );
             part
@@ -266,30 +134,20 @@ fn collect_chunk(
     from: (&[(DVec2, DVec2)], f64),
     onto: &PreparedMap,
     to_onto: &Rigid2,
-    (gate, limit): (f32, f32),
+    gate: f32,
     swap: Option<&Rigid2>,
-    (looked, near): (&mut [WallLookup], &mut [bool]),
+    looked: &mut [WallLookup],
     out: &mut Vec<Pair>,
 ) {
     let (samples, off_from) = from;
     let turn = swap.map(|b_to_a| DVec2::from_angle(b_to_a.theta));
-    for ((&(p, sp), looked), near) in samples.iter().zip(looked).zip(near) {
+    for (&(p, sp), looked) in samples.iter().zip(looked) {
         let m = to_onto.apply(p + off_from * sp);
         let Some(i) = onto.window_index(m) else {
-            *near = limit.is_finite();
             continue;
         };
         if looked.index != i as u32 {
             *looked = onto.wall_lookup(i);
-        }
-        if limit.is_finite() {
-            // A known cell's lookup has the distance; an unknown one's is read on its own.
-            let clearance = if looked.has_wall() {
-                looked.distance
-            } else {
-                onto.wall_clearance(i)
-            };
-            *near = clearance <= limit;
         }
         if !looked.has_wall() || looked.distance > gate {
             continue;
@@ -383,16 +241,30 @@ pub fn refine_with_bias(
             None => samples.into_iter().map(|p| (p, DVec2::ZERO)).collect(),
         }
     };
-    let (mut wa, mut wb) = (Samples::new(sided(a)), Samples::new(sided(b)));
-    let mut pairs = Vec::with_capacity(wa.all.len() + wb.all.len());
+    let (wa, wb) = (sided(a), sided(b));
+    let mut pairs = Vec::with_capacity(wa.len() + wb.len());
+    // One lookup per wall sample, kept between iterations: B's samples in A (`looked_a`),
+    // A's in B (`looked_b`).
+    let (mut looked_a, mut looked_b) = (
+        vec![WallLookup::NONE; wb.len()],
+        vec![WallLookup::NONE; wa.len()],
+    );
     for it in 0..config.max_iterations {
         let f = (it as f32 / (config.max_iterations.max(2) / 2) as f32).min(1.0);
         let gate = config.initial_gate_px + (config.final_gate_px - config.initial_gate_px) * f;
         let scale = config.robust_scale_px;
         pairs.clear();
-        // B's samples in A, then A's in B.
-        wb.collect(off_b, a, &t, gate, None, &mut pairs);
-        wa.collect(off_a, b, &t.inverse(), gate, Some(&t), &mut pairs);
+        collect((&wb, off_b), a, &t, gate, None, &mut looked_a, &mut pairs);
+        let to_b = t.inverse();
+        collect(
+            (&wa, off_a),
+            b,
+            &to_b,
+            gate,
+            Some(&t),
+            &mut looked_b,
+            &mut pairs,
+        );
         if pairs.len() < 10 {
             break;
         }
@@ -538,103 +410,6 @@ mod tests {
         let err = displacement_error(&b, &t, &truth).unwrap();
         assert!(err < 0.5, "{err} px off");
         assert_eq!(run(31), (t, offsets));
-    }
-
-    #[test]
-    fn the_near_set_pairs_exactly_as_a_pass_over_every_sample() {
-        // A and B have the room's walls on a larger free floor, and each a box the other does
-        // not have, over the other's free floor far from its walls. Along a path of poses that settles as
-        // ICP's do, with a shrinking gate and changing offsets, the samples that keep their
-        // near set must give the same pairs, in the same order, as a pass over every sample at
-        // each pose, in both directions.
-        let floor = |box_y: usize| {
-            let room = room();
-            let (w, h) = (300, 300);
-            let cells = (0..w * h)
-                .map(|i| {
-                    let (x, y) = (i % w, i / w);
-                    let in_room = (20..140).contains(&x)
-                        && (20..120).contains(&y)
-                        && room.state(x - 20, y - 20) == grid_core::CellState::Occupied;
-                    let in_box = (180..=260).contains(&x)
-                        && (box_y..=box_y + 80).contains(&y)
-                        && (x == 180 || x == 260 || y == box_y || y == box_y + 80);
-                    if in_room || in_box { 100 } else { 0 }
-                })
-                .collect();
-            grid_core::OccupancyGrid::from_cells(w, h, 0.05, Default::default(), cells).unwrap()
-        };
-        let a = floor(20);
-        let a_to_b = Rigid2::new(0.4, 70.0, -30.0);
-        let b = floor(180).warp(&a_to_b, 420, 420).unwrap();
-        let vc = VerifyConfig::default();
-        let (pa, pb) = (PreparedMap::new(&a, &vc), PreparedMap::new(&b, &vc));
-        let sided = |m: &PreparedMap| -> Vec<(DVec2, DVec2)> {
-            m.wall_samples
-                .iter()
-                .copied()
-                .zip(m.wall_sides.iter().copied())
-                .collect()
-        };
-        let truth = a_to_b.inverse();
-        let key = |pairs: &[Pair]| -> Vec<[f64; 10]> {
-            pairs
-                .iter()
-                .map(|p| {
-                    let v = [p.p, p.sb, p.q, p.sa, p.n];
-                    std::array::from_fn(|i| if i % 2 == 0 { v[i / 2].x } else { v[i / 2].y })
-                })
-                .collect()
-        };
-        let (mut kept_b, mut kept_a) = (Samples::new(sided(&pb)), Samples::new(sided(&pa)));
-        let mut reused = 0;
-        for k in 0..40 {
-            // From 15 px and 4 degrees off towards the truth, by ever smaller steps, with the
-            // gate schedule of the global refinement.
-            let f = 0.85f64.powi(k);
-            let t = Rigid2::new(
-                truth.theta + 4f64.to_radians() * f,
-                truth.tx + 12.0 * f,
-                truth.ty - 9.0 * f,
-            );
-            let gate = (12.0 - 0.75 * k as f32).max(3.0);
-            let (off_a, off_b) = (0.5 * (1.0 - f), 1.5 * (1.0 - f));
-            let to_b = t.inverse();
-            for (kept, off, onto, to_onto, swap, fresh) in [
-                (&mut kept_b, off_b, &pa, t, None, sided(&pb)),
-                (&mut kept_a, off_a, &pb, to_b, Some(&t), sided(&pa)),
-            ] {
-                let picked_before = kept.near.as_ref().map(|n| n.to_onto);
-                let (mut got, mut want) = (Vec::new(), Vec::new());
-                kept.collect(off, onto, &to_onto, gate, swap, &mut got);
-                Samples::new(fresh).collect(off, onto, &to_onto, gate, swap, &mut want);
-                assert!(!want.is_empty(), "step {k}: no pairs at all");
-                assert_eq!(key(&got), key(&want), "step {k}");
-                let near = kept.near.as_ref().unwrap();
-                if picked_before == Some(near.to_onto) {
-                    reused += 1;
-                    // The other map's box lies 40 px and more from every wall here.
-                    let set_aside = kept.all.len() - near.samples.len();
-                    assert!(set_aside >= 250, "step {k}: {set_aside} set aside");
-                }
-            }
-        }
-        assert!(reused > 40, "the near set was reused {reused} times of 80");
-        // A jump that lays B's box on A's (160 px along y in the floor's frame, A's too) must
-        // pick the near set again, and back at the truth once more.
-        let jump = Rigid2::new(0.0, 0.0, -160.0).compose(&truth);
-        for t in [jump, truth] {
-            for (kept, onto, to_onto, swap, fresh) in [
-                (&mut kept_b, &pa, t, None, sided(&pb)),
-                (&mut kept_a, &pb, t.inverse(), Some(&t), sided(&pa)),
-            ] {
-                let (mut got, mut want) = (Vec::new(), Vec::new());
-                kept.collect(1.0, onto, &to_onto, 3.0, swap, &mut got);
-                Samples::new(fresh).collect(1.0, onto, &to_onto, 3.0, swap, &mut want);
-                assert!(want.len() > 100, "{} pairs", want.len());
-                assert_eq!(key(&got), key(&want));
-            }
-        }
     }
 
     #[test]

@@ -431,14 +431,6 @@ impl<'a> PreparedMap<'a> {
         }
     }
 
-    /// Distance from window cell `i` ([`Self::window_index`]) to the nearest occupied cell,
-    /// whether the cell is known or not (infinite when the map has no occupied cell). The
-    /// refinement sets aside the wall samples that lie far from every wall by it.
-    #[inline]
-    pub(crate) fn wall_clearance(&self, i: usize) -> f32 {
-        self.walls.nearest_at(i).map_or(f32::INFINITY, |(_, d)| d)
-    }
-
     /// Unit normal of the wall at occupied cell `(x, y)`, if it has a clear direction.
     #[inline]
     pub fn normal(&self, x: usize, y: usize) -> Option<DVec2> {
