@@ -73,6 +73,11 @@ pub struct EvalArgs {
     /// Turn the stand-out rule off.
     #[arg(long)]
     no_stand_out: bool,
+    /// Override how far from a wall unknown cells count as known where walls are compared
+    /// (`mapmerge::VerifyConfig::shadow_px`, pixels; default: the library's), to measure what
+    /// it changes.
+    #[arg(long)]
+    shadow: Option<f32>,
     /// Override SIFT's nearest / second-nearest ratio (default: the library's), for
     /// calibration experiments.
     #[arg(long)]
@@ -440,6 +445,9 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
     }
     if args.no_stand_out {
         config.pair.verify.stand_out = None;
+    }
+    if let Some(px) = args.shadow {
+        config.pair.verify.shadow_px = px;
     }
     if let Some((lift, margin)) = args.stand_out {
         config.pair.verify.stand_out = Some(mapmerge::verify::StandOut {

@@ -31,10 +31,10 @@ const BLOCK: usize = 32;
 
 /// For each cell of a grid, the nearest occupied cell and the distance to it.
 ///
-/// Only the bounding box of the grid's known cells is computed: every occupied cell lies in
-/// it, and the box is convex, so distances inside it are what the whole grid would give.
-/// Outside it every cell is unknown, and queries there report no wall (a big canvas of
-/// unknown around a map costs nothing).
+/// Only the bounding box of the grid's known cells is computed (grown by a margin with
+/// [`Self::with_margin`]): every occupied cell lies in it, and the box is convex, so distances
+/// inside it are what the whole grid would give. Outside it every cell is unknown, and queries
+/// there report no wall (a big canvas of unknown around a map costs nothing).
 #[derive(Debug, Clone)]
 pub struct NearestOccupied {
     /// The computed window: first column and row, width and height.
@@ -54,10 +54,19 @@ impl NearestOccupied {
     /// When the known window has `u32::MAX` cells or more, or a side longer than 2^20 cells
     /// (the loaders refuse such maps: [`grid_core::io::MAX_SIDE`]).
     pub fn new(grid: &OccupancyGrid) -> Self {
+        Self::with_margin(grid, 0)
+    }
+
+    /// [`Self::new`] over the known cells' bounding box grown by `margin` cells on each side
+    /// (clipped to the grid), for lookups of unknown cells just outside it.
+    ///
+    /// # Panics
+    /// As [`Self::new`].
+    pub fn with_margin(grid: &OccupancyGrid, margin: usize) -> Self {
         // The loaders refuse maps without known cells; a grid built in code gets the whole grid.
-        let (x0, y0, w, h) = grid
-            .known_bounds(0)
-            .unwrap_or((0, 0, grid.width(), grid.height()));
+        let (x0, y0, w, h) =
+            grid.known_bounds(margin)
+                .unwrap_or((0, 0, grid.width(), grid.height()));
         // Window indices are u32 (NONE reserved); with sides up to 2^20, the products that
         // compare two crossings of parabolas stay below 2^62.
         assert!(

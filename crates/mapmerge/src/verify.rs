@@ -94,6 +94,27 @@ pub struct VerifyConfig {
     /// The second way to pass the wall test, for maps whose walls a very noisy sensor left as
     /// speckle (see [`StandOut`]); `None` turns it off. Default `Some(StandOut::default())`.
     pub stand_out: Option<StandOut>,
+    /// Unknown cells within this distance (pixels) of a wall of their map count as known where
+    /// walls are compared: by the refinement's pairing, the local search and the wall lift.
+    /// A map marks the inside of an obstacle behind its wall cells unknown (no beam reached
+    /// it), so without this a wall of the other map that lands a pixel behind the wall is
+    /// neither paired nor counted, while one that lands a pixel in front is counted as a miss:
+    /// placements that push disagreeing walls behind the other map's walls gain lift. Default
+    /// 4 (the wide tolerance: a wall landing up to 4 px behind counts, as a miss at 2 px and a
+    /// hit at 4 px, as one landing in front would); 0 compares known cells only, as before
+    /// 2026-12-03 (docs/EVALUATION.md, "Walls behind walls"). Negative or NaN counts as 0.
+    pub shadow_px: f32,
+}
+
+impl VerifyConfig {
+    /// [`Self::shadow_px`] as used: 0 when negative or NaN.
+    fn shadow(&self) -> f32 {
+        if self.shadow_px >= 0.0 {
+            self.shadow_px
+        } else {
+            0.0
+        }
+    }
 }
 
 /// When no candidate reaches the wall lift bars, one may still be accepted because it stands
@@ -157,12 +178,14 @@ impl Default for VerifyConfig {
             max_contradiction_excess: 0.05,
             basin_ratio: 0.9,
             stand_out: Some(StandOut::default()),
+            shadow_px: 4.0,
         }
     }
 }
 
 /// [`PreparedMap::wall_lookup`] of one window cell: the wall cell nearest to it (`wall`) and
-/// its `distance` (infinite where the cell is unknown or the map has no wall), the wall's
+/// its `distance` (infinite where the cell is unknown, outside the shadow of
+/// [`VerifyConfig::shadow_px`], or the map has no wall), the wall's
 /// `normal` (NaN where it has no clear direction) and free `side`, as
 /// [`PreparedMap::normal_and_side`] gives them. Small and plain, so that the refinement can
 /// keep one per wall sample between its iterations and look the map up again only where a
@@ -228,7 +251,8 @@ pub struct PreparedMap<'a> {
     pub known_cells: usize,
     /// Number of occupied cells.
     pub occupied_cells: usize,
-    /// Share of known cells within the wall tolerance of a wall: what a random placement scores.
+    /// Share of known cells (and cells in a wall's shadow, [`VerifyConfig::shadow_px`]) within
+    /// the wall tolerance of a wall: what a random placement scores.
     pub wall_base_rate: f64,
     /// The same share for the wide tolerance.
     pub wide_base_rate: f64,
@@ -241,8 +265,9 @@ pub struct PreparedMap<'a> {
     /// (see [`PreparedMap::free_side`]).
     pub free_sides: Vec<i8>,
     /// Per cell of the known window, the distance to the nearest occupied cell in quarter
-    /// pixels where the cell is known, [`UNKNOWN_QUARTERS`] where it is unknown: both lookups
-    /// of the local search in one (see [`PreparedMap::known_wall_quarters`]).
+    /// pixels where the cell is known or in a wall's shadow ([`VerifyConfig::shadow_px`]),
+    /// [`UNKNOWN_QUARTERS`] where it is unknown: both lookups of the local search in one (see
+    /// [`PreparedMap::known_wall_quarters`]).
     known_quarters: Vec<u16>,
 }
 
@@ -306,8 +331,10 @@ impl<T: Copy> StridedPicker<T> {
 impl<'a> PreparedMap<'a> {
     /// Precompute the nearest-wall transform and the samples of `grid`.
     pub fn new(grid: &'a OccupancyGrid, config: &VerifyConfig) -> Self {
-        let walls = NearestOccupied::new(grid);
-        // Everything outside the known window is unknown.
+        // The window reaches as far as the shadow beyond the known cells.
+        let shadow = config.shadow();
+        let walls = NearestOccupied::with_margin(grid, shadow.ceil() as usize);
+        // Everything outside the window is unknown.
         let (x0, y0, ww, wh) = walls.window();
         // Count first, then pick the samples: the known cells of a big map run into millions,
         // and only `max_samples` of them are kept. Rows of the window are read as slices of
@@ -324,17 +351,23 @@ impl<'a> PreparedMap<'a> {
             })
         };
         let (mut known_cells, mut occupied_cells) = (0usize, 0usize);
-        let (mut near, mut near_wide) = (0usize, 0usize);
+        // Cells where walls are compared (known, or in a wall's shadow), and those of them near
+        // a wall.
+        let (mut compared, mut near, mut near_wide) = (0usize, 0usize, 0usize);
         for (_, cells, dist) in rows() {
             for (&c, &d) in cells.iter().zip(dist) {
                 let s = OccupancyGrid::classify(c);
+                if s == CellState::Unknown && d > shadow {
+                    continue;
+                }
+                compared += 1;
+                near += usize::from(d <= config.wall_tolerance_px);
+                near_wide += usize::from(d <= config.wide_tolerance_px);
                 if s == CellState::Unknown {
                     continue;
                 }
                 known_cells += 1;
                 occupied_cells += usize::from(s == CellState::Occupied);
-                near += usize::from(d <= config.wall_tolerance_px);
-                near_wide += usize::from(d <= config.wide_tolerance_px);
             }
         }
         let (mut known, mut occ) = (
@@ -345,12 +378,15 @@ impl<'a> PreparedMap<'a> {
         for (y, cells, dist) in rows() {
             for (i, (&c, &d)) in cells.iter().zip(dist).enumerate() {
                 let s = OccupancyGrid::classify(c);
-                if s == CellState::Unknown {
+                if s == CellState::Unknown && d > shadow {
                     known_quarters.push(UNKNOWN_QUARTERS);
                     continue;
                 }
                 // Truncated, as `(d * 4.0) as usize` would; saturating below the sentinel.
                 known_quarters.push(((d * 4.0) as u16).min(UNKNOWN_QUARTERS - 1));
+                if s == CellState::Unknown {
+                    continue;
+                }
                 let p = DVec2::new((x0 + i) as f64, y as f64);
                 known.offer(p);
                 if s == CellState::Occupied {
@@ -361,10 +397,10 @@ impl<'a> PreparedMap<'a> {
         let normals = wall_normals(grid, (x0, y0, ww, wh));
         let free_sides = free_sides(grid, (x0, y0, ww, wh), &normals);
         let rate = |n: usize| {
-            if known_cells == 0 {
+            if compared == 0 {
                 0.0
             } else {
-                n as f64 / known_cells as f64
+                n as f64 / compared as f64
             }
         };
         let (wall_base_rate, wide_base_rate) = (rate(near), rate(near_wide));
@@ -390,10 +426,11 @@ impl<'a> PreparedMap<'a> {
         prepared
     }
 
-    /// Distance from the known cell nearest to point `q` (pixel centres at integers) to the
-    /// nearest occupied cell, in quarter pixels, truncated (at most `UNKNOWN_QUARTERS - 1`);
-    /// [`UNKNOWN_QUARTERS`] where that cell is unknown, outside the known window or the map,
-    /// or the map has no occupied cell. One array lookup: the local search's inner loop.
+    /// Distance from the cell nearest to point `q` (pixel centres at integers) to the nearest
+    /// occupied cell, in quarter pixels, truncated (at most `UNKNOWN_QUARTERS - 1`), where that
+    /// cell is known or in a wall's shadow ([`VerifyConfig::shadow_px`]); [`UNKNOWN_QUARTERS`]
+    /// where it is unknown otherwise, outside the known window or the map, or the map has no
+    /// occupied cell. One array lookup: the local search's inner loop.
     #[inline]
     pub fn known_wall_quarters(&self, q: DVec2) -> u16 {
         // The known window lies inside the map, so its test is the map's too.
@@ -619,8 +656,7 @@ fn wall_hits(
     from: (&PreparedMap, f64),
     onto: (&PreparedMap, f64),
     t: &Rigid2,
-    tol: f32,
-    wide: f32,
+    (tol, wide, shadow): (f32, f32, f32),
 ) -> (usize, usize, usize, usize) {
     let ((from, off_from), (onto, off_onto)) = (from, onto);
     let corrected = off_from != 0.0 || off_onto != 0.0;
@@ -633,7 +669,7 @@ fn wall_hits(
         };
         if let Some((x, y)) = cell_of(onto.grid, m) {
             let state = onto.grid.state(x, y);
-            if state == CellState::Unknown {
+            if state == CellState::Unknown && onto.walls.distance(x, y) > shadow {
                 continue;
             }
             total += 1;
@@ -697,10 +733,14 @@ pub fn verify_with_offsets(
     offsets: [f64; 2],
     config: &VerifyConfig,
 ) -> Verification {
-    let (tol, wide) = (config.wall_tolerance_px, config.wide_tolerance_px);
+    let tols = (
+        config.wall_tolerance_px,
+        config.wide_tolerance_px,
+        config.shadow(),
+    );
     let [off_a, off_b] = offsets;
-    let (h_ba, w_ba, c_ba, n_ba) = wall_hits((b, off_b), (a, off_a), b_to_a, tol, wide);
-    let (h_ab, w_ab, c_ab, n_ab) = wall_hits((a, off_a), (b, off_b), &b_to_a.inverse(), tol, wide);
+    let (h_ba, w_ba, c_ba, n_ba) = wall_hits((b, off_b), (a, off_a), b_to_a, tols);
+    let (h_ab, w_ab, c_ab, n_ab) = wall_hits((a, off_a), (b, off_b), &b_to_a.inverse(), tols);
     let wall_support = n_ba + n_ab;
     let share = |n: usize| {
         if wall_support == 0 {
@@ -811,6 +851,52 @@ mod tests {
         assert_eq!(side(80, 50), DVec2::ZERO);
         // Not a wall cell.
         assert_eq!(side(40, 40), DVec2::ZERO);
+    }
+
+    #[test]
+    fn walls_behind_the_other_maps_walls_are_compared_within_the_shadow() {
+        // B's outer walls sit 2 px outside A's, where A is unknown (behind its walls); the
+        // truth is the identity.
+        let (a, b) = (room(), grown_room(2));
+        let id = Rigid2::new(0.0, 0.0, 0.0);
+        let check = |shadow_px, tol| {
+            let config = VerifyConfig {
+                shadow_px,
+                wall_tolerance_px: tol,
+                ..VerifyConfig::default()
+            };
+            let (pa, pb) = (PreparedMap::new(&a, &config), PreparedMap::new(&b, &config));
+            (verify(&pa, &pb, &id, &config), pa)
+        };
+        // B's wall cells that land in A's unknown (its outer walls and the grown end of its
+        // half wall), all within 2 px of A's walls.
+        let outer = (0..b.height())
+            .flat_map(|y| (0..b.width()).map(move |x| (x, y)))
+            .filter(|&(x, y)| {
+                b.state(x, y) == CellState::Occupied && a.state(x, y) == CellState::Unknown
+            })
+            .count();
+        let (without, pa) = check(0.0, 2.0);
+        // The shadow reaches 3 px behind A's walls, so it takes in B's outer walls. With a
+        // 2 px tolerance they agree (but at the corners, 2.8 px off), with a 1 px one they
+        // disagree: either way they count.
+        let (with, pa3) = check(3.0, 2.0);
+        assert_eq!(with.wall_support, without.wall_support + outer);
+        assert!(with.wall_agreement > 0.98, "{with:?}");
+        let (strict, strict_without) = (check(3.0, 1.0).0, check(0.0, 1.0).0);
+        assert_eq!(strict.wall_support, with.wall_support);
+        assert!(
+            strict.wall_agreement < strict_without.wall_agreement - 0.1,
+            "{strict:?} {strict_without:?}"
+        );
+        // The refinement and the local search see the shadow's cells as known, too: 2 px
+        // outside A's west wall, and not 4 px outside it.
+        let q = |p: &PreparedMap, x| p.known_wall_quarters(DVec2::new(x, 50.0));
+        assert_eq!((q(&pa, 8.0), q(&pa3, 8.0)), (UNKNOWN_QUARTERS, 8));
+        assert_eq!(q(&pa3, 6.0), UNKNOWN_QUARTERS);
+        // A shadow that is no distance is none.
+        assert_eq!(check(f32::NAN, 2.0).0, without);
+        assert_eq!(check(-1.0, 2.0).0, without);
     }
 
     #[test]

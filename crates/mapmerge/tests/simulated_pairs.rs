@@ -125,18 +125,29 @@ fn a_disaster_pair_at_30_percent_overlap_is_registered_after_the_screen() {
 /// degrees, scores almost as well (0.88 of it, scored without range-bias offsets), which made
 /// the pair ambiguous. The placement halfway between the two scores as well as the best: one
 /// broad optimum, not two answers. (Distances and scores from a diagnostic print, not in the
-/// repo; the test checks the outcomes.)
+/// repo; the test checks the outcomes.) That was with walls compared on known cells only;
+/// with the shadow of the walls compared too (`VerifyConfig::shadow_px`, the default since
+/// 2026-12-03) the rival no longer scores as well, so the rule is shown without the shadow,
+/// and the default must register the pair.
 #[test]
 fn a_rival_in_the_best_placements_basin_does_not_make_the_pair_ambiguous() {
     let case = disaster_case(7_001_019, 0.5, 0.3, InverseSensorModel::hector());
-    let (with, error) = registered(&case, &RegisterConfig::default());
+    let (default, error) = registered(&case, &RegisterConfig::default());
+    assert!(
+        error.is_some_and(|e| e <= 3.0),
+        "default: {error:?} px ({:?})",
+        default.reason
+    );
+    let mut config = RegisterConfig::default();
+    config.pair.verify.shadow_px = 0.0;
+    let (with, error) = registered(&case, &config);
     assert!(
         error.is_some_and(|e| e <= 3.0),
         "with the basin rule: {error:?} px ({:?})",
         with.reason
     );
 
-    let mut without = RegisterConfig::default();
+    let mut without = config;
     without.pair.verify.basin_ratio = 0.0;
     let reason = registered(&case, &without).0.reason.unwrap_or_default();
     assert!(
@@ -149,18 +160,29 @@ fn a_rival_in_the_best_placements_basin_does_not_make_the_pair_ambiguous() {
 /// hector --seed 7` (overlap 0.5): the walls are speckle, and no placement reaches the wall
 /// lift bars (the one nearest the truth: wide lift 0.77, wall lift 0.57), but every placement
 /// more than 20 px from it stays below 0.44. The stand-out rule (`VerifyConfig::stand_out`)
-/// accepts it; without the rule the pair is declined.
+/// accepts it; without the rule the pair is declined. That was with walls compared on known
+/// cells only; with the shadow of the walls compared too (`VerifyConfig::shadow_px`, the
+/// default since 2026-12-03) the placement passes the bars by itself, so the rule is shown
+/// without the shadow, and the default must register the pair.
 #[test]
 fn a_placement_that_stands_out_on_speckled_walls_is_accepted() {
     let case = disaster_case(7_003_000, 0.5, 0.3, InverseSensorModel::hector());
-    let (with, error) = registered(&case, &RegisterConfig::default());
+    let (default, error) = registered(&case, &RegisterConfig::default());
+    assert!(
+        error.is_some_and(|e| e <= 3.0),
+        "default: {error:?} px ({:?})",
+        default.reason
+    );
+    let mut config = RegisterConfig::default();
+    config.pair.verify.shadow_px = 0.0;
+    let (with, error) = registered(&case, &config);
     assert!(
         error.is_some_and(|e| e <= 3.0) && with.accepted.is_some_and(|c| c.stands_out),
         "with the stand-out rule: {error:?} px ({:?})",
         with.reason
     );
 
-    let mut without = RegisterConfig::default();
+    let mut without = config;
     without.pair.verify.stand_out = None;
     let reason = registered(&case, &without).0.reason.unwrap_or_default();
     assert!(
