@@ -118,21 +118,13 @@ fn a_disaster_pair_at_30_percent_overlap_is_registered_after_the_screen() {
     registered_only_with(3_000_018, &with, &without, "the screen");
 }
 
-/// Case 19 of the 30 %/30 % noise row of `cargo xtask eval --suites noise --mapper hector
-/// --seed 7` (overlap 0.5, 30 % range noise, mapped with hector's gentle clearing, so the
-/// walls are bands of speckle 10-20 px wide). Among the accepted candidates, one 0.9 px from
-/// the truth scores best; another, 11 px from it on average over B's walls and turned 3
-/// degrees, scores almost as well (0.88 of it, scored without range-bias offsets), which made
-/// the pair ambiguous. The placement halfway between the two scores as well as the best: one
-/// broad optimum, not two answers. (Distances and scores from a diagnostic print, not in the
-/// repo; the test checks the outcomes.) That was with walls compared on known cells only;
-/// with the shadow of the walls compared too (`VerifyConfig::shadow_px`, the default since
-/// 2026-12-03) the rival no longer scores as well, so the rule is shown without the shadow,
-/// and the default must register the pair.
-#[test]
-fn a_rival_in_the_best_placements_basin_does_not_make_the_pair_ambiguous() {
-    let case = disaster_case(7_001_019, 0.5, 0.3, InverseSensorModel::hector());
-    let (default, error) = registered(&case, &RegisterConfig::default());
+/// The basin rule and the stand-out rule were pinned on their cases below with walls compared
+/// on known cells only; with the shadow of the walls compared too (`VerifyConfig::shadow_px`,
+/// the default since 2026-12-03) those cases no longer need them. Checks that the default
+/// registers `case` within 3 px, and returns the configuration without the shadow, where each
+/// rule is shown.
+fn shadowless_after_default(case: &Case) -> RegisterConfig {
+    let (default, error) = registered(case, &RegisterConfig::default());
     assert!(
         error.is_some_and(|e| e <= 3.0),
         "default: {error:?} px ({:?})",
@@ -140,6 +132,22 @@ fn a_rival_in_the_best_placements_basin_does_not_make_the_pair_ambiguous() {
     );
     let mut config = RegisterConfig::default();
     config.pair.verify.shadow_px = 0.0;
+    config
+}
+
+/// Case 19 of the 30 %/30 % noise row of `cargo xtask eval --suites noise --mapper hector
+/// --seed 7` (overlap 0.5, 30 % range noise, mapped with hector's gentle clearing, so the
+/// walls are bands of speckle 10-20 px wide). Among the accepted candidates, one 0.9 px from
+/// the truth scores best; another, 11 px from it on average over B's walls and turned 3
+/// degrees, scores almost as well (0.88 of it, scored without range-bias offsets), which made
+/// the pair ambiguous. The placement halfway between the two scores as well as the best: one
+/// broad optimum, not two answers. (Distances and scores from a diagnostic print, not in the
+/// repo; the test checks the outcomes.) With the shadow the rival no longer scores as well:
+/// see [`shadowless_after_default`].
+#[test]
+fn a_rival_in_the_best_placements_basin_does_not_make_the_pair_ambiguous() {
+    let case = disaster_case(7_001_019, 0.5, 0.3, InverseSensorModel::hector());
+    let config = shadowless_after_default(&case);
     let (with, error) = registered(&case, &config);
     assert!(
         error.is_some_and(|e| e <= 3.0),
@@ -160,21 +168,12 @@ fn a_rival_in_the_best_placements_basin_does_not_make_the_pair_ambiguous() {
 /// hector --seed 7` (overlap 0.5): the walls are speckle, and no placement reaches the wall
 /// lift bars (the one nearest the truth: wide lift 0.77, wall lift 0.57), but every placement
 /// more than 20 px from it stays below 0.44. The stand-out rule (`VerifyConfig::stand_out`)
-/// accepts it; without the rule the pair is declined. That was with walls compared on known
-/// cells only; with the shadow of the walls compared too (`VerifyConfig::shadow_px`, the
-/// default since 2026-12-03) the placement passes the bars by itself, so the rule is shown
-/// without the shadow, and the default must register the pair.
+/// accepts it; without the rule the pair is declined. With the shadow the placement passes the
+/// bars by itself: see [`shadowless_after_default`].
 #[test]
 fn a_placement_that_stands_out_on_speckled_walls_is_accepted() {
     let case = disaster_case(7_003_000, 0.5, 0.3, InverseSensorModel::hector());
-    let (default, error) = registered(&case, &RegisterConfig::default());
-    assert!(
-        error.is_some_and(|e| e <= 3.0),
-        "default: {error:?} px ({:?})",
-        default.reason
-    );
-    let mut config = RegisterConfig::default();
-    config.pair.verify.shadow_px = 0.0;
+    let config = shadowless_after_default(&case);
     let (with, error) = registered(&case, &config);
     assert!(
         error.is_some_and(|e| e <= 3.0) && with.accepted.is_some_and(|c| c.stands_out),
