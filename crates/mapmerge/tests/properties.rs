@@ -98,7 +98,9 @@ proptest! {
     /// On 2026-12-02 afternoon (2799128, and as well with `VerifyConfig::basin_ratio` 0, so
     /// not from the basin rule) the first failure is a 154 x 187 and a 182 x 165 map, the
     /// answer again the truth turned by half a turn (76.1 px off, wall lift 0.82,
-    /// contradiction 0.04, acceptance index 0.98, 77 % overlap).
+    /// contradiction 0.04, acceptance index 0.98, 77 % overlap). With the walls' shadow compared
+    /// (`VerifyConfig::shadow_px`, 2026-12-03) the first failure is an answer 78.0 px off at
+    /// wall lift 0.86.
     /// The failing cases are kept in `properties.proptest-regressions`,
     /// so `cargo test -p mapmerge --test properties -- --ignored` shows them first.
     #[test]
