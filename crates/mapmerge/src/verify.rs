@@ -120,6 +120,13 @@ impl VerifyConfig {
     }
 }
 
+/// Whether walls are compared at a cell in state `s`, `d` from the nearest wall of its map:
+/// where it is known, or in a wall's shadow ([`VerifyConfig::shadow_px`]).
+#[inline]
+fn compared(s: CellState, d: f32, shadow: f32) -> bool {
+    s != CellState::Unknown || d <= shadow
+}
+
 /// When no candidate reaches the wall lift bars, one may still be accepted because it stands
 /// out: its lift at the wide tolerance reaches `min_wide_wall_lift`, its overlap holds walls
 /// ([`Verification::wall_density`] at least `min_wall_density`), it passes the other tests
@@ -272,6 +279,9 @@ pub struct PreparedMap<'a> {
     /// [`UNKNOWN_QUARTERS`] where it is unknown: both lookups of the local search in one (see
     /// [`PreparedMap::known_wall_quarters`]).
     known_quarters: Vec<u16>,
+    /// The shadow ([`VerifyConfig::shadow_px`], as used) `known_quarters` and the base rates
+    /// were computed with; the wall lift compares with the same.
+    shadow: f32,
 }
 
 /// How [`strided`] picks `max` of `len` items: how many it keeps, and the step such that pick
@@ -356,14 +366,14 @@ impl<'a> PreparedMap<'a> {
         let (mut known_cells, mut occupied_cells) = (0usize, 0usize);
         // Cells where walls are compared (known, or in a wall's shadow), and those of them near
         // a wall.
-        let (mut compared, mut near, mut near_wide) = (0usize, 0usize, 0usize);
+        let (mut n_compared, mut near, mut near_wide) = (0usize, 0usize, 0usize);
         for (_, cells, dist) in rows() {
             for (&c, &d) in cells.iter().zip(dist) {
                 let s = OccupancyGrid::classify(c);
-                if s == CellState::Unknown && d > shadow {
+                if !compared(s, d, shadow) {
                     continue;
                 }
-                compared += 1;
+                n_compared += 1;
                 near += usize::from(d <= config.wall_tolerance_px);
                 near_wide += usize::from(d <= config.wide_tolerance_px);
                 if s == CellState::Unknown {
@@ -381,7 +391,7 @@ impl<'a> PreparedMap<'a> {
         for (y, cells, dist) in rows() {
             for (i, (&c, &d)) in cells.iter().zip(dist).enumerate() {
                 let s = OccupancyGrid::classify(c);
-                if s == CellState::Unknown && d > shadow {
+                if !compared(s, d, shadow) {
                     known_quarters.push(UNKNOWN_QUARTERS);
                     continue;
                 }
@@ -400,10 +410,10 @@ impl<'a> PreparedMap<'a> {
         let normals = wall_normals(grid, (x0, y0, ww, wh));
         let free_sides = free_sides(grid, (x0, y0, ww, wh), &normals);
         let rate = |n: usize| {
-            if compared == 0 {
+            if n_compared == 0 {
                 0.0
             } else {
-                n as f64 / compared as f64
+                n as f64 / n_compared as f64
             }
         };
         let (wall_base_rate, wide_base_rate) = (rate(near), rate(near_wide));
@@ -420,6 +430,7 @@ impl<'a> PreparedMap<'a> {
             normals,
             free_sides,
             known_quarters,
+            shadow,
         };
         prepared.wall_sides = prepared
             .wall_samples
@@ -659,7 +670,8 @@ fn wall_hits(
     from: (&PreparedMap, f64),
     onto: (&PreparedMap, f64),
     t: &Rigid2,
-    (tol, wide, shadow): (f32, f32, f32),
+    tol: f32,
+    wide: f32,
 ) -> (usize, usize, usize, usize) {
     let ((from, off_from), (onto, off_onto)) = (from, onto);
     let corrected = off_from != 0.0 || off_onto != 0.0;
@@ -672,7 +684,8 @@ fn wall_hits(
         };
         if let Some((x, y)) = cell_of(onto.grid, m) {
             let state = onto.grid.state(x, y);
-            if state == CellState::Unknown && onto.walls.distance(x, y) > shadow {
+            let cell_d = onto.walls.distance(x, y);
+            if !compared(state, cell_d, onto.shadow) {
                 continue;
             }
             total += 1;
@@ -687,7 +700,7 @@ fn wall_hits(
                     None => f32::INFINITY,
                 }
             } else {
-                onto.walls.distance(x, y)
+                cell_d
             };
             if d <= tol {
                 hits += 1;
@@ -736,14 +749,10 @@ pub fn verify_with_offsets(
     offsets: [f64; 2],
     config: &VerifyConfig,
 ) -> Verification {
-    let tols = (
-        config.wall_tolerance_px,
-        config.wide_tolerance_px,
-        config.shadow(),
-    );
+    let (tol, wide) = (config.wall_tolerance_px, config.wide_tolerance_px);
     let [off_a, off_b] = offsets;
-    let (h_ba, w_ba, c_ba, n_ba) = wall_hits((b, off_b), (a, off_a), b_to_a, tols);
-    let (h_ab, w_ab, c_ab, n_ab) = wall_hits((a, off_a), (b, off_b), &b_to_a.inverse(), tols);
+    let (h_ba, w_ba, c_ba, n_ba) = wall_hits((b, off_b), (a, off_a), b_to_a, tol, wide);
+    let (h_ab, w_ab, c_ab, n_ab) = wall_hits((a, off_a), (b, off_b), &b_to_a.inverse(), tol, wide);
     let wall_support = n_ba + n_ab;
     let share = |n: usize| {
         if wall_support == 0 {
