@@ -140,6 +140,11 @@ pub struct EvalArgs {
     /// experiments.
     #[arg(long, value_parser = angle_window)]
     spectrum_max_delta: Option<f64>,
+    /// Override the wall residual (pixels) below which the spectrum angle is not taken (see
+    /// `mapmerge::SpectrumRotation::min_wall_residual_px`; `0` takes it on every accepted
+    /// answer, as before 2026-12-03), for calibration experiments.
+    #[arg(long, value_parser = non_negative)]
+    spectrum_min_residual: Option<f64>,
     /// Override the rotation window (degrees) of the whole-map placements' second local search
     /// (see `mapmerge::PairConfig::turn_search`; `0` turns that search off; default: the
     /// library's), to measure what it adds.
@@ -196,6 +201,18 @@ fn angle_window(s: &str) -> Result<f64, String> {
         Ok(deg)
     } else {
         Err(format!("expected degrees in [0, 45], got {s:?}"))
+    }
+}
+
+/// A finite number of pixels, 0 or more (`--spectrum-min-residual`).
+fn non_negative(s: &str) -> Result<f64, String> {
+    let px: f64 = s.trim().parse().map_err(|e| format!("{s:?}: {e}"))?;
+    if px.is_finite() && px >= 0.0 {
+        Ok(px)
+    } else {
+        Err(format!(
+            "expected a finite number of pixels >= 0, got {s:?}"
+        ))
     }
 }
 
@@ -522,6 +539,12 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
     }
     if let (Some(deg), Some(sr)) = (args.spectrum_max_delta, &mut config.pair.spectrum_rotation) {
         sr.max_delta_deg = deg;
+    }
+    if let (Some(px), Some(sr)) = (
+        args.spectrum_min_residual,
+        &mut config.pair.spectrum_rotation,
+    ) {
+        sr.min_wall_residual_px = px;
     }
     if args.no_spectrum_rotation {
         config.pair.spectrum_rotation = None;

@@ -16,6 +16,7 @@ use crate::refine::{RefineConfig, refine_with_bias};
 use crate::search::{SearchConfig, local_search};
 use crate::verify::{
     PreparedMap, StandOut, Verification, VerifyConfig, verify, verify_with_offsets,
+    wall_residual_px,
 };
 
 /// Everything that tunes [`register_with`], with documented defaults.
@@ -87,7 +88,9 @@ pub struct PairConfig {
 
 /// The angle of an accepted answer from the Hough spectra of all the walls of both maps
 /// ([`crate::global::spectrum_rotation_near`]), its translation then refined by ICP at that
-/// angle (with the range-bias offsets), kept if it still passes verification.
+/// angle (with the range-bias offsets), kept if it still passes verification. It runs only on
+/// answers whose walls agree no better than noisy walls do
+/// ([`SpectrumRotation::min_wall_residual_px`]).
 ///
 /// On a small overlap the walls ICP pairs span a short lever, and a noisy range sensor's
 /// walls are pushed by amounts that differ from wall to wall: the fitted angle is then off by
@@ -109,6 +112,16 @@ pub struct SpectrumRotation {
     /// Only a spectrum peak this close to the answer's angle (degrees, modulo a half turn) is
     /// taken. Default 2.
     pub max_delta_deg: f64,
+    /// The spectrum angle is taken only when the answer's walls lie on average at least this
+    /// far (pixels) from the other map's, over those within 3 px of one
+    /// ([`crate::verify::wall_residual_px`]). Walls that agree more closely pin the angle
+    /// better than the spectra do: the spectra take every wall of both maps, and two maps that
+    /// hold different parts of a building have different spectra, whose correlation peak can
+    /// lie a few tenths of a degree off. Default 0.3: the answers of the simulated pairs of
+    /// `cargo xtask eval` (noisy walls) lie at 0.39-1.4 px, where the spectrum angle pays
+    /// (docs/EVALUATION.md), and two crops of a fixture floor at 0.01-0.2 px, where it moved
+    /// answers within 0.3 px of the truth to 1-5.7 px.
+    pub min_wall_residual_px: f64,
 }
 
 impl Default for SpectrumRotation {
@@ -117,6 +130,7 @@ impl Default for SpectrumRotation {
             bins: 720,
             max_points: 6000,
             max_delta_deg: 2.0,
+            min_wall_residual_px: 0.3,
         }
     }
 }
@@ -711,6 +725,8 @@ pub fn register_with(
                     .polish
                     .is_none_or(|p| c.verification.wall_lift < p.min_wall_lift)
         })
+        && wall_residual_px(&pa, &pb, &best.transform, 3.0, sr.max_points)
+            .is_some_and(|r| r >= sr.min_wall_residual_px)
         && let Some(theta) = spectrum_rotation_near(
             &pa,
             &pb,

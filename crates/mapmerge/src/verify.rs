@@ -729,6 +729,45 @@ fn lift(hits: usize, support: usize, base_ba: f64, n_ba: usize, base_ab: f64, n_
     }
 }
 
+/// How closely the walls agree under `b_to_a`, where they agree at all: the mean distance
+/// (pixels) from a map's wall cells to the nearest wall cell of the other map, over the wall
+/// cells that land within `within_px` of one (at most `max_points` per map, evenly strided),
+/// in the direction (B onto A, or A onto B) where it is smaller: a map whose walls are marked
+/// only in part lands on the other's walls, while the other's full walls land beside its
+/// gaps. Distances are read per cell ([`PreparedMap::known_wall_quarters`]), so a wall cell
+/// that lands on a wall cell counts 0 and one a cell beside it 1. `None` when fewer than 20
+/// wall cells land that close in either direction.
+///
+/// Walls that a range sensor's noise smeared into bands, or pushed behind the obstacle faces by
+/// different amounts in the two maps, agree to about a pixel at best; two views of the same
+/// crisp floor plan agree to a fraction of one (docs/EVALUATION.md, "Crisp walls and the
+/// spectrum angle").
+pub fn wall_residual_px(
+    a: &PreparedMap,
+    b: &PreparedMap,
+    b_to_a: &Rigid2,
+    within_px: f32,
+    max_points: usize,
+) -> Option<f64> {
+    let within = (within_px.max(0.0) * 4.0) as u16;
+    let mean = |from: &PreparedMap, onto: &PreparedMap, t: &Rigid2| {
+        let (mut sum, mut n) = (0u64, 0usize);
+        for p in strided(&from.wall_samples, max_points) {
+            let q = onto.known_wall_quarters(t.apply(p));
+            if q <= within {
+                sum += q as u64;
+                n += 1;
+            }
+        }
+        (n >= 20).then(|| sum as f64 / (4.0 * n as f64))
+    };
+    let (ba, ab) = (mean(b, a, b_to_a), mean(a, b, &b_to_a.inverse()));
+    match (ba, ab) {
+        (Some(x), Some(y)) => Some(x.min(y)),
+        (x, y) => x.or(y),
+    }
+}
+
 /// Score hypothesis `b_to_a` (maps pixels of `b` onto `a`).
 pub fn verify(
     a: &PreparedMap,
@@ -826,6 +865,7 @@ pub fn verify_with_offsets(
 mod tests {
     use super::*;
     use crate::testmaps::{grown_room, room};
+    use grid_core::UNKNOWN;
 
     #[test]
     fn strided_keeps_evenly_spaced_items() {
@@ -863,6 +903,32 @@ mod tests {
         assert_eq!(side(80, 50), DVec2::ZERO);
         // Not a wall cell.
         assert_eq!(side(40, 40), DVec2::ZERO);
+    }
+
+    #[test]
+    fn the_wall_residual_is_how_far_agreeing_walls_lie_apart() {
+        let vc = VerifyConfig::default();
+        let a = room();
+        let pa = PreparedMap::new(&a, &vc);
+        let residual = |b: &PreparedMap, t: &Rigid2| wall_residual_px(&pa, b, t, 3.0, 20_000);
+        // The map onto itself: every wall cell lands on a wall cell.
+        assert_eq!(residual(&pa, &Rigid2::default()), Some(0.0));
+        // Shifted by a pixel along x: walls along y land a cell beside their twins, walls along
+        // x on them; all within 3 px, about half of them 1 px off.
+        let r = residual(&pa, &Rigid2::new(0.0, 1.0, 0.0)).unwrap();
+        assert!((0.3..0.7).contains(&r), "{r}");
+        // A copy with every third wall cell only: its walls land on A's (0 px), A's beside the
+        // copy's gaps; the smaller direction is the one that tells.
+        let mut sparse = room();
+        for (i, c) in sparse.cells_mut().iter_mut().enumerate() {
+            if *c == 100 && i % 3 != 0 {
+                *c = UNKNOWN;
+            }
+        }
+        let ps = PreparedMap::new(&sparse, &vc);
+        assert_eq!(residual(&ps, &Rigid2::default()), Some(0.0));
+        // Nothing within reach: no residual.
+        assert_eq!(residual(&pa, &Rigid2::new(0.0, 500.0, 0.0)), None);
     }
 
     #[test]
