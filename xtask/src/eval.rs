@@ -145,6 +145,11 @@ pub struct EvalArgs {
     /// answer, as before 2026-12-03), for calibration experiments.
     #[arg(long, value_parser = non_negative)]
     spectrum_min_residual: Option<f64>,
+    /// Override the spread (pixels) of the agreeing walls from which on the spectrum angle is
+    /// not taken (see `mapmerge::SpectrumRotation::max_lever_px`; a large value takes it at
+    /// any spread, as before 2026-12-03), for calibration experiments.
+    #[arg(long, value_parser = non_negative)]
+    spectrum_max_lever: Option<f64>,
     /// Override the rotation window (degrees) of the whole-map placements' second local search
     /// (see `mapmerge::PairConfig::turn_search`; `0` turns that search off; default: the
     /// library's), to measure what it adds.
@@ -545,6 +550,9 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
         &mut config.pair.spectrum_rotation,
     ) {
         sr.min_wall_residual_px = px;
+    }
+    if let (Some(px), Some(sr)) = (args.spectrum_max_lever, &mut config.pair.spectrum_rotation) {
+        sr.max_lever_px = px;
     }
     if args.no_spectrum_rotation {
         config.pair.spectrum_rotation = None;

@@ -768,6 +768,37 @@ pub fn wall_residual_px(
     }
 }
 
+/// How far the walls that agree under `b_to_a` spread: the radius of gyration (pixels, in A's
+/// frame) of B's wall cells that land within `within_px` of a wall cell of A. ICP's angle
+/// rests on this lever. `None` when fewer than 20 wall cells land that close.
+pub fn agreeing_wall_spread_px(
+    a: &PreparedMap,
+    b: &PreparedMap,
+    b_to_a: &Rigid2,
+    within_px: f32,
+) -> Option<f64> {
+    let within = (within_px.max(0.0) * 4.0) as u16;
+    let agree: Vec<DVec2> = b
+        .wall_samples
+        .iter()
+        .map(|p| b_to_a.apply(*p))
+        .filter(|q| a.known_wall_quarters(*q) <= within)
+        .collect();
+    if agree.len() < 20 {
+        return None;
+    }
+    let n = agree.len() as f64;
+    let centre = agree.iter().copied().sum::<DVec2>() / n;
+    Some(
+        (agree
+            .iter()
+            .map(|q| (*q - centre).length_squared())
+            .sum::<f64>()
+            / n)
+            .sqrt(),
+    )
+}
+
 /// Score hypothesis `b_to_a` (maps pixels of `b` onto `a`).
 pub fn verify(
     a: &PreparedMap,
@@ -929,6 +960,30 @@ mod tests {
         assert_eq!(residual(&ps, &Rigid2::default()), Some(0.0));
         // Nothing within reach: no residual.
         assert_eq!(residual(&pa, &Rigid2::new(0.0, 500.0, 0.0)), None);
+    }
+
+    #[test]
+    fn the_agreeing_walls_spread_is_their_radius_of_gyration() {
+        let vc = VerifyConfig::default();
+        let a = room();
+        let pa = PreparedMap::new(&a, &vc);
+        // Onto itself every wall agrees: the spread of all of them, computed directly.
+        let n = pa.wall_samples.len() as f64;
+        let c = pa.wall_samples.iter().copied().sum::<DVec2>() / n;
+        let direct = (pa
+            .wall_samples
+            .iter()
+            .map(|p| (*p - c).length_squared())
+            .sum::<f64>()
+            / n)
+            .sqrt();
+        let spread = agreeing_wall_spread_px(&pa, &pa, &Rigid2::default(), 3.0).unwrap();
+        assert!((spread - direct).abs() < 1e-9, "{spread} against {direct}");
+        // The room is 100 x 80 cells: its walls spread over tens of pixels.
+        assert!((30.0..60.0).contains(&spread), "{spread}");
+        // Placed where no wall of B comes near a wall of A: no lever.
+        let far = Rigid2::new(0.0, 500.0, 0.0);
+        assert_eq!(agreeing_wall_spread_px(&pa, &pa, &far, 3.0), None);
     }
 
     #[test]
