@@ -118,10 +118,11 @@ pub struct SpectrumRotation {
     /// ([`crate::verify::wall_residual_px`]). Walls that agree more closely pin the angle
     /// better than the spectra do: the spectra take every wall of both maps, and two maps that
     /// hold different parts of a building have different spectra, whose correlation peak can
-    /// lie a few tenths of a degree off. Default 0.3: the answers of the simulated pairs of
-    /// `cargo xtask eval` (noisy walls) lie at 0.39-1.4 px, where the spectrum angle pays
-    /// (docs/EVALUATION.md), and two crops of a fixture floor at 0.01-0.2 px, where it moved
-    /// answers within 0.3 px of the truth to 1-5.7 px.
+    /// lie a few tenths of a degree off. Default 0.3: the answers of 94 simulated pairs
+    /// exported by `cargo xtask eval` (noisy walls) lie at 0.33-1.4 px, and two crops of a
+    /// fixture floor (walls marked in full or in part) at 0.005-0.24 px, where the spectrum
+    /// angle moved answers within 0.3 px of the truth up to 5.7 px off (docs/EVALUATION.md,
+    /// "Crisp walls and the spectrum angle").
     pub min_wall_residual_px: f64,
     /// The spectrum angle is taken only when the walls that agree under the answer (B's wall
     /// cells within 3 px of A's) spread less than this far about their centre (radius of
