@@ -209,7 +209,7 @@ fn angle_window(s: &str) -> Result<f64, String> {
     }
 }
 
-/// A finite number of pixels, 0 or more (`--spectrum-min-residual`).
+/// A finite number of pixels, 0 or more (`--spectrum-min-residual`, `--spectrum-max-lever`).
 fn non_negative(s: &str) -> Result<f64, String> {
     let px: f64 = s.trim().parse().map_err(|e| format!("{s:?}: {e}"))?;
     if px.is_finite() && px >= 0.0 {
