@@ -32,7 +32,7 @@ use mapmerge::global::{global_hypotheses, sweep_placements};
 use mapmerge::search::local_search;
 use mapmerge::verify::{PreparedMap, VerifyConfig, verify};
 use mapmerge::{RegisterConfig, refine_and_score, register};
-use mapsim::{CaseConfig, RobotConfig, WorldConfig, WorldKind, generate_case};
+use mapsim::{CaseConfig, generate_case};
 
 fn pair() -> (OccupancyGrid, OccupancyGrid) {
     let path = concat!(
@@ -84,21 +84,10 @@ fn partial_pair() -> (OccupancyGrid, OccupancyGrid) {
         "/../../fixtures/maps/uos_cic/uos_cic.yaml"
     );
     let floor = load_map(path, &LoadOptions::default()).expect("fixture loads");
-    let robot = |noise_bound| RobotConfig {
-        noise_bound,
-        ..RobotConfig::default()
-    };
     let config = CaseConfig {
-        world: WorldConfig {
-            kind: WorldKind::Grid(floor),
-            width: 0,
-            height: 0,
-            ..WorldConfig::default()
-        },
-        robots: vec![robot(0.1), robot(0.2)],
         overlap: 0.5,
         overlap_tolerance: f64::INFINITY,
-        ..CaseConfig::default()
+        ..CaseConfig::floor(floor, &[0.1, 0.2])
     };
     let case = generate_case(&config, 7_014_000).expect("case generates");
     let canvas = |m: &OccupancyGrid| {

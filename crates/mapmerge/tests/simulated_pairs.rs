@@ -200,21 +200,10 @@ fn intel_lab_case(seed: u64) -> Case {
         "/../../fixtures/maps/intel_lab/intel_lab.yaml"
     );
     let floor = grid_core::io::load_map(path, &grid_core::io::LoadOptions::default()).unwrap();
-    let lidar = |noise_bound| RobotConfig {
-        noise_bound,
-        ..RobotConfig::default()
-    };
     let config = CaseConfig {
-        world: WorldConfig {
-            kind: WorldKind::Grid(floor),
-            width: 0,
-            height: 0,
-            ..WorldConfig::default()
-        },
-        robots: vec![lidar(0.1), lidar(0.2)],
         overlap: 0.5,
         overlap_tolerance: f64::INFINITY,
-        ..CaseConfig::default()
+        ..CaseConfig::floor(floor, &[0.1, 0.2])
     };
     generate_case(&config, seed).unwrap()
 }

@@ -246,6 +246,27 @@ impl CaseConfig {
         }
     }
 
+    /// A floor plan (`WorldKind::Grid`: its occupied and unknown cells are obstacles) explored
+    /// by one default lidar robot per entry of `noise_bounds`, with that range noise bound.
+    pub fn floor(plan: OccupancyGrid, noise_bounds: &[f64]) -> Self {
+        Self {
+            world: WorldConfig {
+                kind: WorldKind::Grid(plan),
+                width: 0,
+                height: 0,
+                ..WorldConfig::default()
+            },
+            robots: noise_bounds
+                .iter()
+                .map(|&noise_bound| RobotConfig {
+                    noise_bound,
+                    ..RobotConfig::default()
+                })
+                .collect(),
+            ..Self::default()
+        }
+    }
+
     /// A structured indoor floor of `size x size` cells with two lidar robots.
     pub fn indoor(size: usize) -> Self {
         Self {
