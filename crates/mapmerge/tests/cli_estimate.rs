@@ -182,6 +182,17 @@ fn bad_input_is_refused_with_exit_2() {
     // The debug picture never overwrites an input.
     let err = fails(&[a_s, a_s, "--debug-png", a_s]);
     assert!(err.contains("would overwrite an input map"), "{err}");
+    // Nor is it attempted (after the registration's work) in a directory that does not exist.
+    let nowhere = dir.path().join("no_such_dir").join("matches.png");
+    let err = fails(&[a_s, a_s, "--debug-png", nowhere.to_str().unwrap()]);
+    assert_eq!(
+        err,
+        format!(
+            "mapmerge: error: {}: --debug-png's directory {} does not exist",
+            nowhere.display(),
+            dir.path().join("no_such_dir").display()
+        )
+    );
 
     let err = fails(&[a_s, a_s, "--method", "orb"]);
     assert!(err.contains("unknown method 'orb'"), "{err}");

@@ -89,6 +89,16 @@ pub fn run(args: &EstimateArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode
             ))
             .into());
         }
+        // Checked before the registration's work, not after it.
+        let dir = png.parent().filter(|d| !d.as_os_str().is_empty());
+        if let Some(dir) = dir.filter(|d| !d.is_dir()) {
+            return Err(UsageError(format!(
+                "{}: --debug-png's directory {} does not exist",
+                png.display(),
+                dir.display()
+            ))
+            .into());
+        }
     }
     let a = load(&args.a, bare)?;
     let b = load(&args.b, bare)?;
