@@ -749,19 +749,12 @@ pub fn wall_residual_px(
     within_px: f32,
     max_points: usize,
 ) -> Option<f64> {
-    let within = (within_px.max(0.0) * 4.0) as u16;
-    let mean = |from: &PreparedMap, onto: &PreparedMap, t: &Rigid2| {
-        let (mut sum, mut n) = (0u64, 0usize);
-        for p in strided(&from.wall_samples, max_points) {
-            let q = onto.known_wall_quarters(t.apply(p));
-            if q <= within {
-                sum += q as u64;
-                n += 1;
-            }
-        }
-        (n >= 20).then(|| sum as f64 / (4.0 * n as f64))
+    let mean = |near: Vec<(DVec2, u16)>| {
+        let sum: u64 = near.iter().map(|&(_, q)| q as u64).sum();
+        (near.len() >= 20).then(|| sum as f64 / (4.0 * near.len() as f64))
     };
-    let (ba, ab) = (mean(b, a, b_to_a), mean(a, b, &b_to_a.inverse()));
+    let ba = mean(near_walls(b, a, b_to_a, within_px, max_points));
+    let ab = mean(near_walls(a, b, &b_to_a.inverse(), within_px, max_points));
     match (ba, ab) {
         (Some(x), Some(y)) => Some(x.min(y)),
         (x, y) => x.or(y),
@@ -777,26 +770,38 @@ pub fn agreeing_wall_spread_px(
     b_to_a: &Rigid2,
     within_px: f32,
 ) -> Option<f64> {
-    let within = (within_px.max(0.0) * 4.0) as u16;
-    let agree: Vec<DVec2> = b
-        .wall_samples
-        .iter()
-        .map(|p| b_to_a.apply(*p))
-        .filter(|q| a.known_wall_quarters(*q) <= within)
-        .collect();
-    if agree.len() < 20 {
+    let near = near_walls(b, a, b_to_a, within_px, usize::MAX);
+    if near.len() < 20 {
         return None;
     }
-    let n = agree.len() as f64;
-    let centre = agree.iter().copied().sum::<DVec2>() / n;
-    Some(
-        (agree
-            .iter()
-            .map(|q| (*q - centre).length_squared())
-            .sum::<f64>()
-            / n)
-            .sqrt(),
-    )
+    let n = near.len() as f64;
+    let centre = near.iter().map(|&(q, _)| q).sum::<DVec2>() / n;
+    let spread = near
+        .iter()
+        .map(|&(q, _)| (q - centre).length_squared())
+        .sum::<f64>();
+    Some((spread / n).sqrt())
+}
+
+/// `from`'s wall cells (at most `max_points`, evenly strided) mapped by `t` into `onto`, with
+/// their distance to `onto`'s nearest wall in quarter pixels
+/// ([`PreparedMap::known_wall_quarters`]), for those that land within `within_px` of one.
+fn near_walls(
+    from: &PreparedMap,
+    onto: &PreparedMap,
+    t: &Rigid2,
+    within_px: f32,
+    max_points: usize,
+) -> Vec<(DVec2, u16)> {
+    let within = (within_px.max(0.0) * 4.0) as u16;
+    strided(&from.wall_samples, max_points)
+        .into_iter()
+        .map(|p| {
+            let q = t.apply(p);
+            (q, onto.known_wall_quarters(q))
+        })
+        .filter(|&(_, d)| d <= within)
+        .collect()
 }
 
 /// Score hypothesis `b_to_a` (maps pixels of `b` onto `a`).
