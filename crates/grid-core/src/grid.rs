@@ -342,6 +342,47 @@ impl OccupancyGrid {
         Self::from_cells(width, height, self.resolution(), self.origin(), cells)
     }
 
+    /// The `width x height` region of this grid whose cell `(0, 0)` is cell `(x0, y0)` of this
+    /// grid; `x0` and `y0` may be negative and the region may reach past the grid, where its
+    /// cells are unknown. Cell `p` of the region is cell `p + (x0, y0)` of this grid, and the
+    /// origin is moved so that both give it the same world coordinates.
+    pub fn region(&self, x0: i64, y0: i64, width: usize, height: usize) -> Result<Self> {
+        if width == 0 || height == 0 {
+            return Err(Error::ZeroSize { width, height });
+        }
+        let mut cells = vec![UNKNOWN; width * height];
+        for (y, row) in cells.chunks_exact_mut(width).enumerate() {
+            let Ok(sy) = usize::try_from(y0 + y as i64) else {
+                continue;
+            };
+            if sy >= self.height() {
+                break;
+            }
+            let src = &self.cells[sy * self.width()..(sy + 1) * self.width()];
+            // The columns of the region that lie inside the grid.
+            let first = (-x0).clamp(0, width as i64) as usize;
+            let last = (self.width() as i64 - x0).clamp(0, width as i64) as usize;
+            if first < last {
+                let s0 = (x0 + first as i64) as usize;
+                row[first..last].copy_from_slice(&src[s0..s0 + (last - first)]);
+            }
+        }
+        let r = self.resolution();
+        let o = self.origin();
+        // The lower-left corner of the region's lower-left cell, in this grid's frame.
+        let corner = DVec2::new(
+            x0 as f64 * r,
+            (self.height() as f64 - y0 as f64 - height as f64) * r,
+        );
+        let moved = DVec2::new(o.x, o.y) + DVec2::from_angle(o.yaw).rotate(corner);
+        let origin = Pose2 {
+            x: moved.x,
+            y: moved.y,
+            yaw: o.yaw,
+        };
+        Self::from_cells(width, height, r, origin, cells)
+    }
+
     /// World coordinates of pixel coordinates `p`; see [`GridGeometry::pixel_to_world`].
     pub fn pixel_to_world(&self, p: DVec2) -> DVec2 {
         self.geometry.pixel_to_world(p)
@@ -395,6 +436,57 @@ fn last_known(row: &[u8]) -> Option<usize> {
 mod tests {
     use super::*;
     use proptest::prelude::*;
+
+    #[test]
+    fn a_region_copies_the_cells_it_covers_and_is_unknown_past_the_grid() {
+        let (w, h) = (5, 4);
+        let cells: Vec<u8> = (0..(w * h) as u8).collect();
+        let origin = Pose2 {
+            x: 1.5,
+            y: -2.0,
+            yaw: 0.3,
+        };
+        let g = OccupancyGrid::from_cells(w, h, 0.1, origin, cells).unwrap();
+        // Reaching past every side: two columns and one row before the grid, two after.
+        let r = g.region(-2, -1, w + 4, h + 3).unwrap();
+        assert_eq!((r.width(), r.height()), (9, 7));
+        for y in 0..7i64 {
+            for x in 0..9i64 {
+                let (sx, sy) = (x - 2, y - 1);
+                let inside = (0..w as i64).contains(&sx) && (0..h as i64).contains(&sy);
+                let want = if inside {
+                    (sy as usize * w + sx as usize) as u8
+                } else {
+                    UNKNOWN
+                };
+                assert_eq!(r.get(x as usize, y as usize), Some(want), "cell ({x}, {y})");
+            }
+        }
+        // Cell p of the region lies where cell p + (x0, y0) of the grid lies.
+        for p in [
+            DVec2::new(0.0, 0.0),
+            DVec2::new(3.0, 5.0),
+            DVec2::new(8.0, 6.0),
+        ] {
+            let (got, want) = (
+                r.pixel_to_world(p),
+                g.pixel_to_world(p + DVec2::new(-2.0, -1.0)),
+            );
+            assert!((got - want).length() < 1e-12, "{got} vs {want}");
+        }
+        // Inside the grid: exactly the cells; wholly outside: all unknown.
+        let inner = g.region(1, 2, 3, 2).unwrap();
+        assert_eq!(inner.cells(), &[11, 12, 13, 16, 17, 18]);
+        let outside = g.region(10, -10, 2, 2).unwrap();
+        assert_eq!(outside.cells(), &[UNKNOWN; 4]);
+        assert!(matches!(
+            g.region(0, 0, 0, 3),
+            Err(Error::ZeroSize {
+                width: 0,
+                height: 3
+            })
+        ));
+    }
 
     #[test]
     fn known_bounds_cover_free_and_occupied_cells_only() {
