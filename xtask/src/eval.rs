@@ -150,6 +150,11 @@ pub struct EvalArgs {
     /// any spread, as before 2026-12-03), for calibration experiments.
     #[arg(long, value_parser = non_negative)]
     spectrum_max_lever: Option<f64>,
+    /// Override the unknown border (cells) of the frame each map is registered on (see
+    /// `mapmerge::PairConfig::frame_margin`; `none` registers the maps as given, as before
+    /// 2026-12-03; default: the library's), to measure it.
+    #[arg(long, value_parser = frame_margin)]
+    frame_margin: Option<FrameMargin>,
     /// Override the rotation window (degrees) of the whole-map placements' second local search
     /// (see `mapmerge::PairConfig::turn_search`; `0` turns that search off; default: the
     /// library's), to measure what it adds.
@@ -206,6 +211,20 @@ fn angle_window(s: &str) -> Result<f64, String> {
         Ok(deg)
     } else {
         Err(format!("expected degrees in [0, 45], got {s:?}"))
+    }
+}
+
+/// `--frame-margin`: a number of cells, or `none`.
+#[derive(Debug, Clone, Copy)]
+struct FrameMargin(Option<usize>);
+
+fn frame_margin(s: &str) -> Result<FrameMargin, String> {
+    match s.trim() {
+        "none" => Ok(FrameMargin(None)),
+        t => t
+            .parse()
+            .map(|m| FrameMargin(Some(m)))
+            .map_err(|e| format!("expected a number of cells or `none`, got {s:?}: {e}")),
     }
 }
 
@@ -553,6 +572,9 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
     }
     if let (Some(px), Some(sr)) = (args.spectrum_max_lever, &mut config.pair.spectrum_rotation) {
         sr.max_lever_px = px;
+    }
+    if let Some(FrameMargin(m)) = args.frame_margin {
+        config.pair.frame_margin = m;
     }
     if args.no_spectrum_rotation {
         config.pair.spectrum_rotation = None;

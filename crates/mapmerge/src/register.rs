@@ -5,7 +5,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 use blob_features::{BlobConfig, BlobCorrespondences, Blobs};
-use grid_core::{Correspondence, CorrespondenceSource, EvidenceKind, OccupancyGrid, Rigid2};
+use grid_core::{Correspondence, CorrespondenceSource, DVec2, EvidenceKind, OccupancyGrid, Rigid2};
 use ransac_rigid::{RansacConfig, estimate_rigid};
 use sift_desc::{SiftConfig, SiftCorrespondences};
 
@@ -84,6 +84,15 @@ pub struct PairConfig {
     /// translation refined at that angle, unless the polish applies; `None` disables it.
     /// Default: on, [`SpectrumRotation::default`].
     pub spectrum_rotation: Option<SpectrumRotation>,
+    /// Each map is registered on its own frame: the bounding box of its known cells grown by
+    /// this many cells of unknown on every side, cut out of the map or padded with unknown
+    /// where the map is smaller (`register::framed`). The answer is then the same whatever unknown
+    /// border the maps came with (a map_server map padded to 4000 x 4000, the same map
+    /// cropped tight), and the transform, candidates and matches are given in the maps' own
+    /// pixels. `None` registers the maps as given. Default `Some(64)`: the scale space's crop
+    /// margin (`scale_space::ScaleSpaceConfig::crop_margin`), so the intensity image is the
+    /// same as for a map with that much unknown border or more.
+    pub frame_margin: Option<usize>,
 }
 
 /// The angle of an accepted answer from the Hough spectra of all the walls of both maps
@@ -241,6 +250,7 @@ impl Default for PairConfig {
             offsets_in_verification: true,
             polish: Some(PolishConfig::default()),
             spectrum_rotation: Some(SpectrumRotation::default()),
+            frame_margin: Some(64),
         }
     }
 }
@@ -498,11 +508,53 @@ fn screen(
         .collect()
 }
 
+/// `grid` on the bounding box of its known cells grown by `margin` cells on every side (see
+/// [`PairConfig::frame_margin`]), and the position in `grid` of the frame's cell `(0, 0)`;
+/// `grid` itself, at offset zero, when it has no known cell.
+fn framed(grid: &OccupancyGrid, margin: usize) -> (OccupancyGrid, DVec2) {
+    let Some((x0, y0, w, h)) = grid.known_bounds(0) else {
+        return (grid.clone(), DVec2::ZERO);
+    };
+    let (fx, fy) = (x0 as i64 - margin as i64, y0 as i64 - margin as i64);
+    let frame = grid
+        .region(fx, fy, w + 2 * margin, h + 2 * margin)
+        .expect("a known cell gives a non-empty frame");
+    (frame, DVec2::new(fx as f64, fy as f64))
+}
+
+/// `t`, which maps pixels of B's frame onto A's frame, as a map of B's pixels onto A's, the
+/// frames' cells `(0, 0)` lying at `oa` in A and `ob` in B: `p -> t(p - ob) + oa`.
+fn unframed(t: &Rigid2, oa: DVec2, ob: DVec2) -> Rigid2 {
+    let moved = t.apply(-ob) + oa;
+    Rigid2::new(t.theta, moved.x, moved.y)
+}
+
 /// Register `b` onto `a` using the correspondences of `sources`.
 ///
 /// Never fails: a pair without a trustworthy answer comes back with `accepted: None` and a
 /// reason, which the binary turns into exit code 3.
 pub fn register_with(
+    a: &OccupancyGrid,
+    b: &OccupancyGrid,
+    sources: &[&(dyn CorrespondenceSource + Sync)],
+    config: &PairConfig,
+) -> Registration {
+    let Some(margin) = config.frame_margin else {
+        return register_as_given(a, b, sources, config);
+    };
+    let ((fa, oa), (fb, ob)) = rayon::join(|| framed(a, margin), || framed(b, margin));
+    let mut r = register_as_given(&fa, &fb, sources, config);
+    for c in r.accepted.iter_mut().chain(r.candidates.iter_mut()) {
+        c.transform = unframed(&c.transform, oa, ob);
+    }
+    for m in &mut r.matches {
+        (m.a, m.b) = (m.a + oa, m.b + ob);
+    }
+    r
+}
+
+/// [`register_with`] on the maps as given (no frames).
+fn register_as_given(
     a: &OccupancyGrid,
     b: &OccupancyGrid,
     sources: &[&(dyn CorrespondenceSource + Sync)],
@@ -921,6 +973,29 @@ mod tests {
             },
             ..RegisterConfig::default()
         }
+    }
+
+    #[test]
+    fn a_frame_is_the_known_cells_grown_by_the_margin_wherever_they_lie() {
+        let a = room();
+        let (x0, y0, w, h) = a.known_bounds(0).unwrap();
+        let (frame, offset) = framed(&a, 3);
+        assert_eq!((frame.width(), frame.height()), (w + 6, h + 6));
+        assert_eq!(offset, DVec2::new(x0 as f64 - 3.0, y0 as f64 - 3.0));
+        // The same cells, padded unevenly first: the same frame, at the offset moved with them.
+        let padded = a.region(-40, -7, a.width() + 50, a.height() + 9).unwrap();
+        let (again, moved) = framed(&padded, 3);
+        assert_eq!(again.cells(), frame.cells());
+        assert_eq!(moved, offset + DVec2::new(40.0, 7.0));
+        // A transform between frames, given in the maps' pixels.
+        let t = Rigid2::new(0.7, 12.0, -5.0);
+        let (oa, ob) = (DVec2::new(3.0, -4.0), DVec2::new(-10.0, 25.0));
+        let p = DVec2::new(17.0, 9.0);
+        let got = unframed(&t, oa, ob).apply(p);
+        assert!((got - (t.apply(p - ob) + oa)).length() < 1e-12, "{got}");
+        // A map with no known cell stays as it is.
+        let blank = OccupancyGrid::new(10, 8, 0.05, grid_core::Pose2::default()).unwrap();
+        assert_eq!(framed(&blank, 3), (blank.clone(), DVec2::ZERO));
     }
 
     #[test]

@@ -1,7 +1,8 @@
 //! Registration of simulated pairs with known truth: the whole-map searches (the rotation
 //! sweep's placements, `PairConfig::turn_search`) and the ambiguity test's basin rule
 //! (`VerifyConfig::basin_ratio`), the stand-out rule of acceptance (`VerifyConfig::stand_out`)
-//! and the spectrum angle's lever (`SpectrumRotation::max_lever_px`).
+//! and the spectrum angle's lever (`SpectrumRotation::max_lever_px`), and that the answer does not
+//! depend on the maps' unknown border (`PairConfig::frame_margin`).
 
 use grid_core::metrics::displacement_error;
 use mapmerge::{RegisterConfig, Registration, register};
@@ -79,44 +80,48 @@ fn registered_only_with(seed: u64, with: &RegisterConfig, without: &RegisterConf
     );
 }
 
-/// Case 19: no keypoint agrees, and the rotation sweep's nearest placement (with the former
-/// sweep; the present one proposes a nearer one) is about 8 px and a degree off, where ICP and
-/// the translation-only search settle 8-9 px from the truth and the pair was declined.
+/// Case 10 of seed 3, with the former sweep (the present one proposes nearer placements): ICP
+/// and the translation-only search settle 6.7 px from the truth, and the search over +-2
+/// degrees leads ICP to within 1.7 px. (Case 19 of seed 7 showed it until the maps were
+/// registered on their frames, `PairConfig::frame_margin`: `cargo xtask eval --suites overlap
+/// --only "disaster, overlap 0.3" --seed 3 --sweep-peaks 1 --sweep-keep-normalized 8
+/// --sweep-screen 0`, with and without `--turn-search 0`.)
 #[test]
 fn a_disaster_pair_at_30_percent_overlap_is_registered_after_the_turn_search() {
     let with = with_former_sweep(RegisterConfig::default());
     let mut without = with.clone();
     without.pair.turn_search = None;
-    registered_only_with(7_000_019, &with, &without, "the turn search");
+    registered_only_with(3_000_010, &with, &without, "the turn search");
 }
 
-/// Case 14: most of B's walls at the truth land on A's unknown area, and at the true angle the
-/// rotation sweep's best translation lays B's long arena wall along A's. The placement near the
-/// truth is only a lesser peak of its angle's correlation and ranks well below eighth among the
-/// normalised ranking's distinct placements, so the pair was declined when the sweep kept one
-/// translation per angle and eight placements per ranking.
+/// Case 11: declined when the sweep kept one translation per angle and eight placements per
+/// ranking, registered (1.8 px) by the present sweep's lesser peaks; the screen alone changes
+/// nothing here. (Case 14 showed it, a lesser peak of the true angle's correlation, until the
+/// maps were registered on their frames; it is now declined either way.)
 #[test]
 fn a_disaster_pair_at_30_percent_overlap_is_registered_from_a_lesser_sweep_peak() {
     let with = RegisterConfig::default();
     let without = with_former_sweep(with.clone());
     registered_only_with(
-        7_000_014,
+        7_000_011,
         &with,
         &without,
         "the sweep's lesser peaks and screen",
     );
 }
 
-/// Case 18 of seed 3: the placement near the truth is not among the 24 best of the sweep's
-/// normalised ranking, which alone were refined before the screen; searched locally and
-/// scored, it ranked second of 100 in scratch code, so the screen passes it on and the pair,
-/// declined before, is registered.
+/// Case 16 of seed 4: without the screen (the 24 best of the sweep's normalised ranking
+/// refined as ranked) the pair is declined; the screen passes on a placement that leads to
+/// 2.0 px. Since the frames (`PairConfig::frame_margin`) this is the only such case among
+/// the disaster 30 % rows of seeds 3, 4, 7, 8 and 9 (`cargo xtask eval --suites overlap
+/// --only "disaster, overlap 0.3" --seed S`, with and without `--sweep-screen 0`); case 18 of
+/// seed 3 showed it before, and now registers either way.
 #[test]
 fn a_disaster_pair_at_30_percent_overlap_is_registered_after_the_screen() {
     let with = RegisterConfig::default();
     let mut without = with.clone();
     without.pair.sweep.as_mut().unwrap().screened = 0;
-    registered_only_with(3_000_018, &with, &without, "the screen");
+    registered_only_with(4_000_016, &with, &without, "the screen");
 }
 
 /// The basin rule and the stand-out rule were pinned on their cases below with walls compared
@@ -223,4 +228,68 @@ fn an_intel_lab_pair_keeps_icps_angle_on_a_long_lever() {
         .1
         .expect("accepted");
     assert!(after <= 3.0, "{after} px off");
+}
+
+/// The answer does not depend on the unknown border the maps come with
+/// (`PairConfig::frame_margin`): the same pair, each map cut tight to its known cells or
+/// padded unevenly with unknown cells, gives the same candidates, the same decision and the
+/// same transform (in each input's own pixels), up to the rounding of the frames' offsets.
+/// Before the frames, a border one pixel wider turned the scale space's sampling and the
+/// whole-map searches' grids, and such a pair (the bench's partial maps) was answered on one
+/// canvas and declined on another.
+#[test]
+fn the_answer_does_not_depend_on_the_maps_unknown_border() {
+    // Disaster 30 % case 12: keypoints, the sweep and the symmetry probes all take part, and
+    // a symmetry probe's placement is the answer.
+    let case = disaster_case(7_000_012, 0.3, 0.1, InverseSensorModel::default());
+    let (a, b) = (&case.robots[0].map, &case.robots[1].map);
+    let given = register(a, b, &RegisterConfig::default()).unwrap();
+    // Map `m`'s region from `(x0, y0)` to `width x height` (negative corners pad), and where
+    // the map's own pixel (0, 0) lies in it.
+    let moved = |m: &grid_core::OccupancyGrid, x0: i64, y0: i64, w: usize, h: usize| {
+        let r = m.region(x0, y0, w, h).unwrap();
+        (r, grid_core::DVec2::new(-x0 as f64, -y0 as f64))
+    };
+    let tight = |m: &grid_core::OccupancyGrid| {
+        let (x0, y0, w, h) = m.known_bounds(0).unwrap();
+        moved(m, x0 as i64, y0 as i64, w, h)
+    };
+    let padded = |m: &grid_core::OccupancyGrid, left: i64, top: i64, extra: usize| {
+        moved(
+            m,
+            -left,
+            -top,
+            m.width() + left as usize + extra,
+            m.height() + top as usize + extra,
+        )
+    };
+    for ((a2, oa), (b2, ob)) in [
+        (tight(a), tight(b)),
+        (padded(a, 37, 5, 120), padded(b, 1, 90, 3)),
+        (tight(a), padded(b, 200, 200, 200)),
+    ] {
+        let r = register(&a2, &b2, &RegisterConfig::default()).unwrap();
+        assert_eq!(r.accepted.is_some(), given.accepted.is_some());
+        assert_eq!(r.reason, given.reason);
+        assert_eq!(r.candidates.len(), given.candidates.len());
+        for (c, g) in r.candidates.iter().zip(&given.candidates) {
+            assert_eq!(
+                (c.origin, c.accepted, c.verification),
+                (g.origin, g.accepted, g.verification)
+            );
+            // The candidate in the given maps' pixels: p -> t(p + ob) - oa.
+            let t = c.transform;
+            let back = t.apply(ob) - oa;
+            let g = g.transform;
+            assert!(
+                (t.theta - g.theta).abs() < 1e-9
+                    && (back.x - g.tx).abs() < 1e-6
+                    && (back.y - g.ty).abs() < 1e-6,
+                "{t:?} (offsets {oa}, {ob}) against {g:?}"
+            );
+        }
+    }
+    // The case is answered, so the comparison covers an accepted transform.
+    let answer = given.accepted.as_ref().expect("case 12 is answered");
+    assert_eq!(answer.origin, mapmerge::Origin::Symmetry);
 }
