@@ -150,6 +150,10 @@ pub struct EvalArgs {
     /// any spread, as before 2026-12-03), for calibration experiments.
     #[arg(long, value_parser = non_negative)]
     spectrum_max_lever: Option<f64>,
+    /// Also refine each whole-map placement from where it was proposed (see
+    /// `mapmerge::PairConfig::refine_placements_as_proposed`), to measure what it adds.
+    #[arg(long)]
+    refine_placements_as_proposed: bool,
     /// Override the unknown border (cells) of the frame each map is registered on (see
     /// `mapmerge::PairConfig::frame_margin`; `none` registers the maps as given, as before
     /// 2026-12-03; default: the library's), to measure it.
@@ -572,6 +576,9 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
     }
     if let (Some(px), Some(sr)) = (args.spectrum_max_lever, &mut config.pair.spectrum_rotation) {
         sr.max_lever_px = px;
+    }
+    if args.refine_placements_as_proposed {
+        config.pair.refine_placements_as_proposed = true;
     }
     if let Some(FrameMargin(m)) = args.frame_margin {
         config.pair.frame_margin = m;

@@ -93,6 +93,14 @@ pub struct PairConfig {
     /// margin (`scale_space::ScaleSpaceConfig::crop_margin`), so the intensity image is the
     /// same as for a map with that much unknown border or more.
     pub frame_margin: Option<usize>,
+    /// Refine a whole-map placement (global search, sweep, symmetry probes) from where it was
+    /// proposed as well, not only from where its local search and its turn search moved it.
+    /// Default false: on `cargo xtask eval --suites overlap,zero,paper,real,noise --cases 20
+    /// --seed 7` (at 9c1cf25, before the frames) every row registered the same pairs without
+    /// it (three answers moved by 0.3-0.5 px, each nearer the truth), and it is a third of
+    /// those placements' refinements: the bench's partial pair took 1.5-1.7 s instead of
+    /// 1.9-2.3 s on one thread (scratch timing, three runs each).
+    pub refine_placements_as_proposed: bool,
 }
 
 /// The angle of an accepted answer from the Hough spectra of all the walls of both maps
@@ -251,6 +259,7 @@ impl Default for PairConfig {
             polish: Some(PolishConfig::default()),
             spectrum_rotation: Some(SpectrumRotation::default()),
             frame_margin: Some(64),
+            refine_placements_as_proposed: false,
         }
     }
 }
@@ -611,7 +620,9 @@ fn register_as_given(
     // correlative local search around it (keypoints, or the global search's coarse grid, can
     // put it a few pixels off, outside ICP's narrow basin), and for whole-map placements once
     // more from the best pose of the turn search; the polished pose the maps agree with most
-    // wins. Global hypotheses refine with their own, wider-gated configuration.
+    // wins (the first of equals). A whole-map placement is refined from itself only when
+    // neither search moved it, unless `refine_placements_as_proposed`. Global hypotheses
+    // refine with their own, wider-gated configuration.
     let check = |model: &Rigid2, refine_config: &RefineConfig, origin: Origin| {
         // Whole-map placements are also searched over rotation.
         let turn_search = if origin == Origin::Ransac {
@@ -625,15 +636,35 @@ fn register_as_given(
             (moved != *model).then(|| refined(&moved))
         };
         // The polishes are independent: run them side by side.
-        let (((mut transform, mut verification), searched), turned) = rayon::join(
-            || rayon::join(|| refined(model), || searched(config.search.as_ref())),
-            || searched(turn_search),
-        );
-        for (t, v) in [searched, turned].into_iter().flatten() {
-            if v.score() > verification.score() {
-                (transform, verification) = (t, v);
+        let polishes = if turn_search.is_some() && !config.refine_placements_as_proposed {
+            let (searched, turned) = rayon::join(
+                || searched(config.search.as_ref()),
+                || searched(turn_search),
+            );
+            match (searched, turned) {
+                (None, None) => vec![refined(model)],
+                (searched, turned) => [searched, turned].into_iter().flatten().collect(),
             }
-        }
+        } else {
+            let ((own, searched), turned) = rayon::join(
+                || rayon::join(|| refined(model), || searched(config.search.as_ref())),
+                || searched(turn_search),
+            );
+            [Some(own), searched, turned]
+                .into_iter()
+                .flatten()
+                .collect()
+        };
+        let (transform, verification) = polishes
+            .into_iter()
+            .reduce(|best, p| {
+                if p.1.score() > best.1.score() {
+                    p
+                } else {
+                    best
+                }
+            })
+            .expect("at least one polish");
         Candidate {
             transform,
             ransac_inliers: 0,
