@@ -15,7 +15,7 @@
 //! whose keypoints agree, so RANSAC answers.
 //!
 //! `partial_maps/*`: the stages that dominate that hard pair, each on its own, on the same
-//! pair prepared once: the rotation sweep (`sweep_placements`), the Hough-spectrum and
+//! pair framed (`mapmerge::framed`) and prepared once: the rotation sweep (`sweep_placements`), the Hough-spectrum and
 //! correlation search (`global_hypotheses`), one correlative local search over +-2 degrees
 //! (the turn search each whole-map placement gets), one refinement and scoring of a
 //! placement (`refine_and_score`: ICP with the range-bias offsets, then verification) and one
@@ -31,7 +31,7 @@ use grid_core::{CorrespondenceSource, OccupancyGrid, Rigid2, UNKNOWN};
 use mapmerge::global::{global_hypotheses, sweep_placements};
 use mapmerge::search::local_search;
 use mapmerge::verify::{PreparedMap, VerifyConfig, verify};
-use mapmerge::{RegisterConfig, refine_and_score, register};
+use mapmerge::{RegisterConfig, framed, refine_and_score, register};
 use mapsim::{CaseConfig, generate_case};
 
 fn pair() -> (OccupancyGrid, OccupancyGrid) {
@@ -145,11 +145,17 @@ fn bench(c: &mut Criterion) {
     });
     g.finish();
 
-    // The hard pair's stages, on the maps prepared as `register` prepares them.
+    // The hard pair's stages, on the maps framed and prepared as `register` frames and
+    // prepares them.
     let pair_config = &config.pair;
+    let frame = |m: &OccupancyGrid| match pair_config.frame_margin {
+        Some(margin) => framed(m, margin).0,
+        None => m.clone(),
+    };
+    let (fa, fb) = (frame(&pa), frame(&pb));
     let (ppa, ppb) = (
-        PreparedMap::new(&pa, &pair_config.verify),
-        PreparedMap::new(&pb, &pair_config.verify),
+        PreparedMap::new(&fa, &pair_config.verify),
+        PreparedMap::new(&fb, &pair_config.verify),
     );
     let sweep = pair_config.sweep.expect("the default runs the sweep");
     let global = pair_config

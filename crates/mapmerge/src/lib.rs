@@ -17,5 +17,5 @@ mod testmaps;
 
 pub use register::{
     Candidate, KindTotals, Method, Origin, PairConfig, PolishConfig, RegisterConfig, Registration,
-    SpectrumRotation, Timings, refine_and_score, register, register_with,
+    SpectrumRotation, Timings, framed, refine_and_score, register, register_with,
 };

@@ -86,7 +86,7 @@ pub struct PairConfig {
     pub spectrum_rotation: Option<SpectrumRotation>,
     /// Each map is registered on its own frame: the bounding box of its known cells grown by
     /// this many cells of unknown on every side, cut out of the map or padded with unknown
-    /// where the map is smaller (`register::framed`). The answer is then the same whatever unknown
+    /// where the map is smaller ([`framed`]). The answer is then the same whatever unknown
     /// border the maps came with (a map_server map padded to 4000 x 4000, the same map
     /// cropped tight), and the transform, candidates and matches are given in the maps' own
     /// pixels. `None` registers the maps as given. Default `Some(64)`: the scale space's crop
@@ -520,7 +520,7 @@ fn screen(
 /// `grid` on the bounding box of its known cells grown by `margin` cells on every side (see
 /// [`PairConfig::frame_margin`]), and the position in `grid` of the frame's cell `(0, 0)`;
 /// `grid` itself, at offset zero, when it has no known cell.
-fn framed(grid: &OccupancyGrid, margin: usize) -> (OccupancyGrid, DVec2) {
+pub fn framed(grid: &OccupancyGrid, margin: usize) -> (OccupancyGrid, DVec2) {
     let Some((x0, y0, w, h)) = grid.known_bounds(0) else {
         return (grid.clone(), DVec2::ZERO);
     };
