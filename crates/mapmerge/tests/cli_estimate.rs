@@ -1,5 +1,6 @@
 //! `mapmerge estimate` through the real binary: known transforms recovered on real maps,
-//! unrelated maps declined with exit code 3, bad input refused with exit code 2.
+//! unrelated maps declined with exit code 3, bad input refused with exit code 2, and a map padded
+//! with unknown cells answered as it was.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -284,4 +285,47 @@ fn registers_from_area_evidence_alone() {
     assert!(r.inliers.area >= 2, "{:?}", r.inliers);
     assert!(rotation_error_deg(&c.transform, &truth) < 0.5);
     assert!(displacement_error(&b, &c.transform, &truth).unwrap() < 1.0);
+}
+
+#[test]
+fn padding_a_map_with_unknown_cells_leaves_the_answer_in_place() {
+    // B of the real pair saved again with an uneven border of unknown cells (100 columns on
+    // the left, 37 rows on top, 50 on the other sides) and its origin moved so that every
+    // cell keeps its world position, as a map server padding the map would save it.
+    let dir = TempDir::new().unwrap();
+    let b = load_map(fixture("sunil_pair_b"), &LoadOptions::default()).unwrap();
+    let padded = b
+        .region(-100, -37, b.width() + 150, b.height() + 87)
+        .unwrap();
+    // Both written the same way, so that they differ by the padding alone.
+    let (given_path, padded_path) = (dir.path().join("b.yaml"), dir.path().join("b_padded.yaml"));
+    save_map(&b, &given_path).unwrap();
+    save_map(&padded, &padded_path).unwrap();
+    let a = fixture("sunil_pair_a");
+    let given = json(&run(&[&a, &given_path]));
+    assert!(given["transform"].is_object(), "{given}");
+    let out = run(&[&a, &padded_path]);
+    assert_eq!(out.status.code(), Some(0));
+    let moved = json(&out);
+    // The same decision and scores, and the same pose of B's map frame in A's: the padding
+    // moved B's origin within that frame, not the frame.
+    assert_eq!(moved["verification"], given["verification"]);
+    assert_eq!(moved["candidates"], given["candidates"]);
+    for key in ["x", "y", "yaw"] {
+        let (got, want) = (moved["world"][key].as_f64(), given["world"][key].as_f64());
+        assert!(
+            (got.unwrap() - want.unwrap()).abs() < 1e-9,
+            "world {key}: {got:?} vs {want:?}"
+        );
+    }
+    // The pixel transform: B's cell p is the padded map's cell p + (100, 37).
+    let (t, g) = (transform(&moved), transform(&given));
+    for p in [
+        DVec2::new(0.0, 0.0),
+        DVec2::new(250.0, 120.0),
+        DVec2::new(499.0, 399.0),
+    ] {
+        let (got, want) = (t.apply(p + DVec2::new(100.0, 37.0)), g.apply(p));
+        assert!((got - want).length() < 1e-6, "{got} vs {want} at {p}");
+    }
 }
