@@ -26,7 +26,9 @@ pub struct GlobalConfig {
     pub rotation_peaks: usize,
     /// Wall points used for the spectrum and the correlation at most. Default 6000.
     pub max_points: usize,
-    /// Longest side of the coarse correlation images, in coarse cells. Default 192.
+    /// Cells of the coarse correlation images across the longest of the side of A's known
+    /// cells' bounding box and the diagonal of B's (not the grids' sizes: a map's unknown
+    /// border does not coarsen them). Default 192.
     pub coarse_size: usize,
     /// Translation peaks kept per angle. Default 2.
     pub translation_peaks: usize,
@@ -222,8 +224,9 @@ struct CoarseField {
 }
 
 impl CoarseField {
-    /// A's field at a scale where the larger of A's sides and B's diagonal spans `coarse_size`
-    /// cells, padded so that every shift of B stays unambiguous.
+    /// A's field at a scale where the larger of the sides of A's known cells' bounding box
+    /// and the diagonal of B's spans `coarse_size` cells, padded so that every shift of B
+    /// stays unambiguous.
     fn new(
         a: &PreparedMap,
         b: &PreparedMap,
@@ -234,7 +237,16 @@ impl CoarseField {
     ) -> Self {
         let (wa, ha) = (a.grid.width() as f64, a.grid.height() as f64);
         let diag_b = ((b.grid.width() as f64).powi(2) + (b.grid.height() as f64).powi(2)).sqrt();
-        let scale = (wa.max(ha).max(diag_b) / coarse_size as f64).max(1.0);
+        // The scale follows the known cells' extents, not the grids' sizes, so that a map's
+        // unknown border (its frame's margin, `PairConfig::frame_margin`) does not coarsen it.
+        let extent = |m: &PreparedMap| {
+            m.grid
+                .known_bounds(0)
+                .map_or((m.grid.width(), m.grid.height()), |(_, _, w, h)| (w, h))
+        };
+        let ((ka_w, ka_h), (kb_w, kb_h)) = (extent(a), extent(b));
+        let known_diag_b = (kb_w as f64).hypot(kb_h as f64);
+        let scale = ((ka_w.max(ka_h) as f64).max(known_diag_b) / coarse_size as f64).max(1.0);
         let (cw, ch) = (
             (wa / scale).ceil() as usize + 1,
             (ha / scale).ceil() as usize + 1,
@@ -527,9 +539,10 @@ pub fn twins(
 pub struct SweepConfig {
     /// Angle step of the sweep over the full turn, in degrees. Default 2.
     pub step_deg: f64,
-    /// Longest side of the coarse correlation images, in coarse cells. Default 96 (about 5 px
-    /// per cell for the 400 x 400 simulated maps): coarse enough to be cheap and to absorb
-    /// walls that a noisy sensor smeared over several pixels.
+    /// Cells of the coarse correlation images across the longest of the side of A's known
+    /// cells' bounding box and the diagonal of B's (as [`GlobalConfig::coarse_size`]).
+    /// Default 96 (about 5 px per cell for the 400 x 400 simulated maps): coarse enough to be
+    /// cheap and to absorb walls that a noisy sensor smeared over several pixels.
     pub coarse_size: usize,
     /// Wall points of B correlated at most. Default 4000.
     pub max_points: usize,
