@@ -15,11 +15,11 @@
 //! whose keypoints agree, so RANSAC answers.
 //!
 //! `partial_maps/*`: the stages that dominate that hard pair, each on its own, on the same
-//! pair framed (`mapmerge::framed`) and prepared once: the rotation sweep (`sweep_placements`), the Hough-spectrum and
-//! correlation search (`global_hypotheses`), one correlative local search over +-2 degrees
-//! (the turn search each whole-map placement gets), one refinement and scoring of a
-//! placement (`refine_and_score`: ICP with the range-bias offsets, then verification) and one
-//! verification alone. The end-to-end time is about one sweep and one global search plus a
+//! pair framed (`mapmerge::framed`) and prepared once: the rotation sweep
+//! (`sweep_placements`), the Hough-spectrum and correlation search (`global_hypotheses`), one
+//! correlative local search over +-2 degrees (the turn search each whole-map placement gets),
+//! one refinement and scoring of a placement (`refine_and_score`: ICP with the range-bias
+//! offsets, then verification) and one verification alone. The end-to-end time is about one sweep and one global search plus a
 //! few dozen placements each searched, refined and scored (see `timings_ms` of
 //! `mapmerge estimate --json`).
 //!
