@@ -351,6 +351,10 @@ impl OccupancyGrid {
             return Err(Error::ZeroSize { width, height });
         }
         let mut cells = vec![UNKNOWN; width * height];
+        // The columns of the region that lie inside the grid, and the first of them in it.
+        let first = (-x0).clamp(0, width as i64) as usize;
+        let last = (self.width() as i64 - x0).clamp(0, width as i64) as usize;
+        let s0 = (x0 + first as i64) as usize;
         for (y, row) in cells.chunks_exact_mut(width).enumerate() {
             let Ok(sy) = usize::try_from(y0 + y as i64) else {
                 continue;
@@ -358,13 +362,9 @@ impl OccupancyGrid {
             if sy >= self.height() {
                 break;
             }
-            let src = &self.cells[sy * self.width()..(sy + 1) * self.width()];
-            // The columns of the region that lie inside the grid.
-            let first = (-x0).clamp(0, width as i64) as usize;
-            let last = (self.width() as i64 - x0).clamp(0, width as i64) as usize;
             if first < last {
-                let s0 = (x0 + first as i64) as usize;
-                row[first..last].copy_from_slice(&src[s0..s0 + (last - first)]);
+                let src = &self.cells[sy * self.width() + s0..][..last - first];
+                row[first..last].copy_from_slice(src);
             }
         }
         let r = self.resolution();

@@ -5,6 +5,7 @@
 //! depend on the maps' unknown border (`PairConfig::frame_margin`).
 
 use grid_core::metrics::displacement_error;
+use grid_core::{DVec2, OccupancyGrid};
 use mapmerge::{Origin, RegisterConfig, Registration, register};
 use mapsim::{
     Case, CaseConfig, InverseSensorModel, RobotConfig, WorldConfig, WorldKind, generate_case,
@@ -82,7 +83,8 @@ fn registered_only_with(seed: u64, with: &RegisterConfig, without: &RegisterConf
 
 /// Case 10 of seed 3, with the former sweep (the present one proposes nearer placements): ICP
 /// and the translation-only search settle 6.7 px from the truth, and the search over +-2
-/// degrees leads ICP to within 1.7 px. (Case 19 of seed 7 showed it until the maps were
+/// degrees leads ICP to within 1.7 px (measured with the frames, before the coarse images
+/// followed the known cells' extents; the test checks the outcomes). (Case 19 of seed 7 showed it until the maps were
 /// registered on their frames, `PairConfig::frame_margin`: `cargo xtask eval --suites overlap
 /// --only "disaster, overlap 0.3" --seed 3 --sweep-peaks 1 --sweep-keep-normalized 8
 /// --sweep-screen 0`, with and without `--turn-search 0`.)
@@ -252,15 +254,15 @@ fn the_answer_does_not_depend_on_the_maps_unknown_border() {
     let given = register(a, b, &RegisterConfig::default()).unwrap();
     // Map `m`'s region from `(x0, y0)` to `width x height` (negative corners pad), and where
     // the map's own pixel (0, 0) lies in it.
-    let moved = |m: &grid_core::OccupancyGrid, x0: i64, y0: i64, w: usize, h: usize| {
+    let moved = |m: &OccupancyGrid, x0: i64, y0: i64, w: usize, h: usize| {
         let r = m.region(x0, y0, w, h).unwrap();
-        (r, grid_core::DVec2::new(-x0 as f64, -y0 as f64))
+        (r, DVec2::new(-x0 as f64, -y0 as f64))
     };
-    let tight = |m: &grid_core::OccupancyGrid| {
+    let tight = |m: &OccupancyGrid| {
         let (x0, y0, w, h) = m.known_bounds(0).unwrap();
         moved(m, x0 as i64, y0 as i64, w, h)
     };
-    let padded = |m: &grid_core::OccupancyGrid, left: i64, top: i64, extra: usize| {
+    let padded = |m: &OccupancyGrid, left: i64, top: i64, extra: usize| {
         moved(
             m,
             -left,
