@@ -168,6 +168,12 @@ pub struct EvalArgs {
     /// default: the library's), to measure what it adds.
     #[arg(long)]
     range_bias: Option<f64>,
+    /// Override where the range-bias prior centres each map's offset, in pixels
+    /// (`mapmerge::refine::RefineConfig::range_bias_mean_px`; default: the library's, 0). With
+    /// a large `--range-bias` the offsets stay there: the walls of both maps are then taken to
+    /// sit that far behind the obstacle faces.
+    #[arg(long)]
+    range_bias_mean: Option<f64>,
     /// How the simulated robots fold their beams into their maps (`default`, or `hector`:
     /// gentle clearing, so noisy walls stay as speckle; see `cargo xtask gen --help`). Row
     /// labels name a mapper other than the default.
@@ -456,6 +462,11 @@ struct Outcome {
     accepted: bool,
     rotation_error_deg: Option<f64>,
     displacement_error_px: Option<f64>,
+    /// The accepted answer's error at the centroid of B's known cells, split into the part
+    /// along the line from the centroid of A's known cells to it (as the truth places it;
+    /// positive: B placed too far from A, the maps overlapping less than they do) and the part
+    /// across that line (px). Shows whether errors push the maps apart.
+    separation_error_px: Option<[f64; 2]>,
     success: bool,
     millis: f64,
     error: Option<String>,
@@ -526,6 +537,10 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
         let prior = (w > 0.0).then_some(w);
         config.pair.refine.range_bias = prior;
         config.pair.global_refine.range_bias = prior;
+    }
+    if let Some(px) = args.range_bias_mean {
+        config.pair.refine.range_bias_mean_px = px;
+        config.pair.global_refine.range_bias_mean_px = px;
     }
     if let Some(sweep) = config.pair.sweep.as_mut() {
         if let Some(k) = args.sweep_keep {
@@ -643,6 +658,7 @@ fn run_case(
         accepted: false,
         rotation_error_deg: None,
         displacement_error_px: None,
+        separation_error_px: None,
         success: false,
         millis: 0.0,
         error: None,
@@ -725,6 +741,7 @@ fn run_case(
                 out.accepted = true;
                 out.rotation_error_deg = Some(rotation_error_deg(&c.transform, &truth));
                 out.displacement_error_px = displacement_error(b, &c.transform, &truth);
+                out.separation_error_px = separation_error(a, b, &c.transform, &truth);
             }
             out.success = if row.expect_decline {
                 !out.accepted
@@ -738,6 +755,34 @@ fn run_case(
             Ok(out)
         })
         .collect()
+}
+
+/// The centroid of a grid's known cells, if it has any.
+fn known_centroid(grid: &grid_core::OccupancyGrid) -> Option<DVec2> {
+    let (mut sum, mut n) = (DVec2::ZERO, 0.0);
+    for y in 0..grid.height() {
+        for x in 0..grid.width() {
+            if grid.state(x, y) != grid_core::CellState::Unknown {
+                sum += DVec2::new(x as f64, y as f64);
+                n += 1.0;
+            }
+        }
+    }
+    (n > 0.0).then(|| sum / n)
+}
+
+/// See [`Outcome::separation_error_px`]: `[along, across]`, or `None` when a map has no known
+/// cell or the two centroids coincide.
+fn separation_error(
+    a: &grid_core::OccupancyGrid,
+    b: &grid_core::OccupancyGrid,
+    answer: &Rigid2,
+    truth: &Rigid2,
+) -> Option<[f64; 2]> {
+    let (ca, cb) = (known_centroid(a)?, known_centroid(b)?);
+    let towards_b = (truth.apply(cb) - ca).try_normalize()?;
+    let e = answer.apply(cb) - truth.apply(cb);
+    Some([e.dot(towards_b), towards_b.perp_dot(e)])
 }
 
 fn median(mut v: Vec<f64>) -> Option<f64> {
@@ -845,9 +890,9 @@ pub fn run(args: EvalArgs) -> Result<()> {
     let mut table = String::new();
     writeln!(
         table,
-        "| suite | case family | method | cases | success | accepted | false accepts | median rot. err (deg) | median disp. err (px) | mean overlap | mean time (ms) |"
+        "| suite | case family | method | cases | success | accepted | false accepts | median rot. err (deg) | median disp. err (px) | mean error along the separation (px) | mean overlap | mean time (ms) |"
     )?;
-    writeln!(table, "|---|---|---|---|---|---|---|---|---|---|---|")?;
+    writeln!(table, "|---|---|---|---|---|---|---|---|---|---|---|---|")?;
     for row in selected.iter().map(|&r| &rows[r]) {
         for &m in &args.methods {
             let os: Vec<&Outcome> = outcomes
@@ -866,6 +911,13 @@ pub fn run(args: EvalArgs) -> Result<()> {
                 .count();
             let rot = median(os.iter().filter_map(|o| o.rotation_error_deg).collect());
             let disp = median(os.iter().filter_map(|o| o.displacement_error_px).collect());
+            // Over the answers near the truth (within 10 px): a systematic push shows there.
+            let along: Vec<f64> = os
+                .iter()
+                .filter(|o| o.displacement_error_px.is_some_and(|d| d <= 10.0))
+                .filter_map(|o| o.separation_error_px.map(|[along, _]| along))
+                .collect();
+            let along = (!along.is_empty()).then(|| along.iter().sum::<f64>() / along.len() as f64);
             let overlap = os.iter().map(|o| o.achieved_overlap).sum::<f64>() / n;
             let time = os.iter().map(|o| o.millis).sum::<f64>() / n;
             let cases = if errors > 0 {
@@ -875,7 +927,7 @@ pub fn run(args: EvalArgs) -> Result<()> {
             };
             writeln!(
                 table,
-                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.2} | {:.0} |",
+                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.2} | {:.0} |",
                 row.suite,
                 row.label,
                 m,
@@ -885,6 +937,7 @@ pub fn run(args: EvalArgs) -> Result<()> {
                 pct(false_acc),
                 fmt_opt(rot, 2),
                 fmt_opt(disp, 2),
+                fmt_opt(along, 2),
                 overlap,
                 time
             )?;
@@ -892,7 +945,13 @@ pub fn run(args: EvalArgs) -> Result<()> {
     }
     print!("{table}");
     if let Some(prefix) = &args.out {
-        let md = prefix.with_extension("md");
+        // Appended, not `with_extension`: a prefix such as `runs/mean_2.5` keeps its dot.
+        let with = |ext: &str| {
+            let mut name = prefix.as_os_str().to_owned();
+            name.push(ext);
+            PathBuf::from(name)
+        };
+        let md = with(".md");
         let cmd = std::env::args().skip(1).collect::<Vec<_>>().join(" ");
         std::fs::write(&md, format!("Command: `cargo xtask {cmd}`\n\n{table}"))
             .with_context(|| format!("writing {}", md.display()))?;
@@ -901,7 +960,7 @@ pub fn run(args: EvalArgs) -> Result<()> {
             lines.push_str(&serde_json::to_string(o)?);
             lines.push('\n');
         }
-        let jl = prefix.with_extension("jsonl");
+        let jl = with(".jsonl");
         std::fs::write(&jl, lines).with_context(|| format!("writing {}", jl.display()))?;
         eprintln!("wrote {} and {}", md.display(), jl.display());
     }
