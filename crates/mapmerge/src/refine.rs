@@ -63,9 +63,10 @@ pub struct RefineConfig {
     pub lock_rotation: bool,
     /// Where the prior of [`Self::range_bias`] centres each offset, and where the offsets
     /// start, in pixels (clamped to the offsets' bounds; NaN counts as 0). Default 0: no bias
-    /// expected. Equal offsets cancel where both maps saw a wall from the same side; where
-    /// they saw it from opposite sides they pull the walls' bands apart, which no data can
-    /// tell from a translation across the wall, so there the prior decides. Offsets held at
+    /// expected. Equal offsets cancel where both maps saw a wall from the same side;
+    /// elsewhere (one map saw it from one side and the other from both, or the two from
+    /// opposite sides) they move the walls relative to each other, which the data cannot
+    /// tell from a translation across those walls, so there the prior sets how far. Offsets held at
     /// 2.5 px (`cargo xtask eval --range-bias 1000000 --range-bias-mean 2.5`) registered more
     /// of the simulated 30 % overlap pairs but fewer pairs of the real floors, so it is not
     /// the default (docs/EVALUATION.md, "Answers that push the maps apart").
