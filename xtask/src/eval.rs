@@ -174,6 +174,11 @@ pub struct EvalArgs {
     /// sit that far behind the obstacle faces.
     #[arg(long)]
     range_bias_mean: Option<f64>,
+    /// Override the correlative local search's kernel width in pixels, for both its searches
+    /// (`mapmerge::search::SearchConfig::sigma_px`; default: the library's), for calibration
+    /// experiments.
+    #[arg(long)]
+    search_sigma: Option<f64>,
     /// How the simulated robots fold their beams into their maps (`default`, or `hector`:
     /// gentle clearing, so noisy walls stay as speckle; see `cargo xtask gen --help`). Row
     /// labels name a mapper other than the default.
@@ -573,6 +578,14 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
     }
     if args.no_polish {
         config.pair.polish = None;
+    }
+    if let Some(px) = args.search_sigma {
+        for search in [&mut config.pair.search, &mut config.pair.turn_search]
+            .into_iter()
+            .flatten()
+        {
+            search.sigma_px = px;
+        }
     }
     if let Some(deg) = args.turn_search {
         config.pair.turn_search = (deg > 0.0).then(|| SearchConfig {
