@@ -15,13 +15,13 @@
 //! whose keypoints agree, so RANSAC answers.
 //!
 //! `partial_maps/*`: the stages that dominate that hard pair, each on its own, on the same
-//! pair framed (`mapmerge::framed`) and prepared once: the rotation sweep
+//! pair framed (`PairConfig::frame`) and prepared once: the rotation sweep
 //! (`sweep_placements`), the Hough-spectrum and correlation search (`global_hypotheses`), one
 //! correlative local search over +-2 degrees (the turn search each whole-map placement gets),
 //! one refinement and scoring of a placement (`refine_and_score`: ICP with the range-bias
-//! offsets, then verification) and one verification alone. The end-to-end time is about one sweep and one global search plus a
-//! few dozen placements each searched, refined and scored (see `timings_ms` of
-//! `mapmerge estimate --json`).
+//! offsets, then verification) and one verification alone. The end-to-end time is about one
+//! sweep and one global search plus a few dozen placements each searched, refined and scored
+//! (see `timings_ms` of `mapmerge estimate --json`).
 //!
 //! Run: `cargo bench -p mapmerge --bench register`.
 
@@ -31,7 +31,7 @@ use grid_core::{CorrespondenceSource, OccupancyGrid, Rigid2, UNKNOWN};
 use mapmerge::global::{global_hypotheses, sweep_placements};
 use mapmerge::search::local_search;
 use mapmerge::verify::{PreparedMap, VerifyConfig, verify};
-use mapmerge::{RegisterConfig, framed, refine_and_score, register};
+use mapmerge::{RegisterConfig, refine_and_score, register};
 use mapsim::{CaseConfig, generate_case};
 
 fn pair() -> (OccupancyGrid, OccupancyGrid) {
@@ -148,10 +148,7 @@ fn bench(c: &mut Criterion) {
     // The hard pair's stages, on the maps framed and prepared as `register` frames and
     // prepares them.
     let pair_config = &config.pair;
-    let frame = |m: &OccupancyGrid| match pair_config.frame_margin {
-        Some(margin) => framed(m, margin).0,
-        None => m.clone(),
-    };
+    let frame = |m: &OccupancyGrid| pair_config.frame(m).map_or_else(|| m.clone(), |(f, _)| f);
     let (fa, fb) = (frame(&pa), frame(&pb));
     let (ppa, ppb) = (
         PreparedMap::new(&fa, &pair_config.verify),

@@ -234,6 +234,15 @@ impl Default for PolishConfig {
     }
 }
 
+impl PairConfig {
+    /// The frame `grid` is registered on under this configuration ([`framed`] with
+    /// [`Self::frame_margin`]) and the position in `grid` of the frame's cell `(0, 0)`; `None`
+    /// when frames are off and the maps are registered as given.
+    pub fn frame(&self, grid: &OccupancyGrid) -> Option<(OccupancyGrid, DVec2)> {
+        self.frame_margin.map(|margin| framed(grid, margin))
+    }
+}
+
 impl Default for PairConfig {
     fn default() -> Self {
         Self {
@@ -548,10 +557,10 @@ pub fn register_with(
     sources: &[&(dyn CorrespondenceSource + Sync)],
     config: &PairConfig,
 ) -> Registration {
-    let Some(margin) = config.frame_margin else {
+    let (Some((fa, oa)), Some((fb, ob))) = rayon::join(|| config.frame(a), || config.frame(b))
+    else {
         return register_as_given(a, b, sources, config);
     };
-    let ((fa, oa), (fb, ob)) = rayon::join(|| framed(a, margin), || framed(b, margin));
     let mut r = register_as_given(&fa, &fb, sources, config);
     for c in r.accepted.iter_mut().chain(r.candidates.iter_mut()) {
         c.transform = unframed(&c.transform, oa, ob);
@@ -1027,6 +1036,17 @@ mod tests {
         // A map with no known cell stays as it is.
         let blank = OccupancyGrid::new(10, 8, 0.05, grid_core::Pose2::default()).unwrap();
         assert_eq!(framed(&blank, 3), (blank.clone(), DVec2::ZERO));
+        // The configuration's frame: the margin it names, or none.
+        let config = PairConfig {
+            frame_margin: Some(3),
+            ..PairConfig::default()
+        };
+        assert_eq!(config.frame(&a), Some((frame, offset)));
+        let as_given = PairConfig {
+            frame_margin: None,
+            ..config
+        };
+        assert_eq!(as_given.frame(&a), None);
     }
 
     #[test]
