@@ -45,11 +45,12 @@ pub struct SearchConfig {
     /// Finer levels after the coarse grid, each a 3 x 3 x 3 grid at half the previous steps
     /// around the best pose so far. Default 3 (final steps 0.25 px and 0.125 degrees).
     pub levels: usize,
-    /// Width of the score kernel, in pixels. Default 1.5: about the spread of a wall's cells
-    /// under 10 % range noise at the simulator's ranges. 3.5 registered more pairs over seeds
-    /// 7-9 (`cargo xtask eval --search-sigma 3.5`: 185 against 169 of 360 on the 30 % and real
-    /// rows, fewer false accepts) but is not the default until the pinned tests it changes are
-    /// re-pinned (docs/EVALUATION.md, "The local search's kernel width").
+    /// Width of the score kernel, in pixels. Default 3.5: wider than a wall's spread under
+    /// 10 % range noise (about 1.5 px at the simulator's ranges), so that walls each map pushed
+    /// its own way by range bias still draw the pose towards the truth. Over seeds 7-9 it
+    /// registered 185 of the 360 pairs of the 30 % and real rows where 1.5 px registered 169,
+    /// with fewer false accepts (`cargo xtask eval --search-sigma PX`; docs/EVALUATION.md,
+    /// "The local search's kernel width").
     pub sigma_px: f64,
     /// Wall cells used per map on the finer levels (strided sample). Default 2000.
     pub max_points: usize,
@@ -65,7 +66,7 @@ impl Default for SearchConfig {
             max_angle_deg: 0.0,
             angle_step_deg: 1.0,
             levels: 3,
-            sigma_px: 1.5,
+            sigma_px: 3.5,
             max_points: 2000,
             coarse_points: 500,
         }
