@@ -49,8 +49,10 @@ pub struct SearchConfig {
     /// 10 % range noise (about 1.5 px at the simulator's ranges), so that walls each map pushed
     /// its own way by range bias still draw the pose towards the truth. Over seeds 7-9 it
     /// registered 185 of the 360 pairs of the 30 % and real rows where 1.5 px registered 169,
-    /// with fewer false accepts (`cargo xtask eval --search-sigma PX`; docs/EVALUATION.md,
-    /// "The local search's kernel width").
+    /// with fewer false accepts (`cargo xtask eval --search-sigma PX`). Maps whose walls stay
+    /// in place as speckle (`--mapper hector`) lose by it: 98 instead of 105 of their 120 pairs
+    /// at 30 % overlap; 2.5 px costs neither kind of map anything (docs/EVALUATION.md, "The
+    /// local search's kernel width").
     pub sigma_px: f64,
     /// Wall cells used per map on the finer levels (strided sample). Default 2000.
     pub max_points: usize,
