@@ -179,6 +179,15 @@ pub struct EvalArgs {
     /// experiments.
     #[arg(long)]
     search_sigma: Option<f64>,
+    /// Override how many wall cells per map every ICP refinement pairs while its gate shrinks
+    /// (`mapmerge::refine::RefineConfig::coarse_points`; default: the library's). A number
+    /// at least `max_points` (6000) uses all of them throughout, as before the coarse phase.
+    #[arg(long)]
+    refine_coarse_points: Option<usize>,
+    /// Override the step, in pixels, below which every ICP refinement stops
+    /// (`mapmerge::refine::RefineConfig::tolerance_px`; default: the library's).
+    #[arg(long)]
+    refine_tolerance: Option<f64>,
     /// How the simulated robots fold their beams into their maps (`default`, or `hector`:
     /// gentle clearing, so noisy walls stay as speckle; see `cargo xtask gen --help`). Row
     /// labels name a mapper other than the default.
@@ -585,6 +594,17 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
             .flatten()
         {
             search.sigma_px = px;
+        }
+    }
+    for refine in [&mut config.pair.refine, &mut config.pair.global_refine]
+        .into_iter()
+        .chain(config.pair.polish.as_mut().map(|p| &mut p.refine))
+    {
+        if let Some(n) = args.refine_coarse_points {
+            refine.coarse_points = n;
+        }
+        if let Some(px) = args.refine_tolerance {
+            refine.tolerance_px = px;
         }
     }
     if let Some(deg) = args.turn_search {
