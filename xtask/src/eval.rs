@@ -184,6 +184,11 @@ pub struct EvalArgs {
     /// at least `max_points` (6000) uses all of them throughout, as before the coarse phase.
     #[arg(long)]
     refine_coarse_points: Option<usize>,
+    /// Override how many placements of each whole-map search are refined by ICP
+    /// (`mapmerge::PairConfig::refined_placements`; `0` refines all of them, as before
+    /// 2026-12-04; default: the library's).
+    #[arg(long)]
+    refined_placements: Option<usize>,
     /// Override the step, in pixels, below which every ICP refinement stops
     /// (`mapmerge::refine::RefineConfig::tolerance_px`; default: the library's).
     #[arg(long)]
@@ -624,6 +629,9 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
     }
     if let (Some(px), Some(sr)) = (args.spectrum_max_lever, &mut config.pair.spectrum_rotation) {
         sr.max_lever_px = px;
+    }
+    if let Some(k) = args.refined_placements {
+        config.pair.refined_placements = (k > 0).then_some(k);
     }
     if args.refine_placements_as_proposed {
         config.pair.refine_placements_as_proposed = true;

@@ -101,6 +101,19 @@ pub struct PairConfig {
     /// those placements' refinements: the bench's partial pair took 1.5-1.7 s instead of
     /// 1.9-2.3 s on one thread (scratch timing, three runs each).
     pub refine_placements_as_proposed: bool,
+    /// Of the placements one whole-map search proposes (global search, sweep, symmetry
+    /// probes), at most this many are refined by ICP: those whose best start (the poses the
+    /// local and turn searches lead to) the maps agree with most, by the verification's
+    /// score. The others are kept as candidates at that start, scored there
+    /// ([`Candidate::refined`] false), and one is refined only if it comes to rank first or
+    /// to stand out, so the answer is always refined. `None` refines every placement.
+    /// Default `Some(8)`: the 2048 x 2048 bench's hard pair, whose searches propose about
+    /// 50 placements, registers in 0.50-0.51 s instead of 0.63 s with every placement
+    /// refined (`cargo bench -p mapmerge --bench register`, ICP's stopping rule in both),
+    /// and on the 30 % overlap rows and real floors of `cargo xtask eval` (seeds 7-9, both
+    /// mappers; 640 pairs) two pairs changed, both for the better (docs/EVALUATION.md, "ICP
+    /// that stops once converged").
+    pub refined_placements: Option<usize>,
 }
 
 /// The angle of an accepted answer from the Hough spectra of all the walls of both maps
@@ -269,6 +282,7 @@ impl Default for PairConfig {
             spectrum_rotation: Some(SpectrumRotation::default()),
             frame_margin: Some(64),
             refine_placements_as_proposed: false,
+            refined_placements: Some(8),
         }
     }
 }
@@ -291,6 +305,10 @@ pub struct Candidate {
     pub stands_out: bool,
     /// Where the hypothesis came from.
     pub origin: Origin,
+    /// Whether ICP refined it. A whole-map placement beyond
+    /// [`PairConfig::refined_placements`] is kept where its local search led and scored there;
+    /// it is refined only if it comes to be the best candidate, or the one that stands out.
+    pub refined: bool,
 }
 
 /// Which stage proposed a candidate; serialised in lower case (`"ransac"`, ...), as the
@@ -632,39 +650,45 @@ fn register_as_given(
     // wins (the first of equals). A whole-map placement is refined from itself only when
     // neither search moved it, unless `refine_placements_as_proposed`. Global hypotheses
     // refine with their own, wider-gated configuration.
-    let check = |model: &Rigid2, refine_config: &RefineConfig, origin: Origin| {
+    //
+    // `starts` gives the poses a hypothesis is refined from, `polished` refines them and
+    // keeps the best.
+    let starts = |model: &Rigid2, origin: Origin| -> Vec<Rigid2> {
         // Whole-map placements are also searched over rotation.
         let turn_search = if origin == Origin::Ransac {
             None
         } else {
             config.turn_search.as_ref()
         };
-        let refined = |start: &Rigid2| refine_and_score(&pa, &pb, start, refine_config, config);
         let searched = |sc: Option<&SearchConfig>| {
             let moved = local_search(&pa, &pb, model, sc?);
-            (moved != *model).then(|| refined(&moved))
+            (moved != *model).then_some(moved)
         };
-        // The polishes are independent: run them side by side.
-        let polishes = if turn_search.is_some() && !config.refine_placements_as_proposed {
-            let (searched, turned) = rayon::join(
-                || searched(config.search.as_ref()),
-                || searched(turn_search),
-            );
-            match (searched, turned) {
-                (None, None) => vec![refined(model)],
-                (searched, turned) => [searched, turned].into_iter().flatten().collect(),
-            }
-        } else {
-            let ((own, searched), turned) = rayon::join(
-                || rayon::join(|| refined(model), || searched(config.search.as_ref())),
-                || searched(turn_search),
-            );
-            [Some(own), searched, turned]
-                .into_iter()
-                .flatten()
-                .collect()
-        };
-        let (transform, verification) = polishes
+        // The searches are independent: run them side by side.
+        let (searched, turned) = rayon::join(
+            || searched(config.search.as_ref()),
+            || searched(turn_search),
+        );
+        let from_itself = turn_search.is_none()
+            || config.refine_placements_as_proposed
+            || (searched.is_none() && turned.is_none());
+        [from_itself.then_some(*model), searched, turned]
+            .into_iter()
+            .flatten()
+            .collect()
+    };
+    let candidate = |(transform, verification): (Rigid2, Verification), origin: Origin| Candidate {
+        transform,
+        ransac_inliers: 0,
+        ransac_confidence: 0.0,
+        accepted: verification.accepted(&config.verify),
+        stands_out: false,
+        verification,
+        origin,
+        refined: true,
+    };
+    let best_of = |scored: Vec<(Rigid2, Verification)>| {
+        scored
             .into_iter()
             .reduce(|best, p| {
                 if p.1.score() > best.1.score() {
@@ -673,16 +697,63 @@ fn register_as_given(
                     best
                 }
             })
-            .expect("at least one polish");
-        Candidate {
-            transform,
-            ransac_inliers: 0,
-            ransac_confidence: 0.0,
-            accepted: verification.accepted(&config.verify),
-            stands_out: false,
-            verification,
-            origin,
+            .expect("at least one start")
+    };
+    let polished = |starts: &[Rigid2], refine_config: &RefineConfig, origin: Origin| {
+        // Side by side: the refinements are independent.
+        let scored: Vec<(Rigid2, Verification)> = starts
+            .par_iter()
+            .map(|s| refine_and_score(&pa, &pb, s, refine_config, config))
+            .collect();
+        candidate(best_of(scored), origin)
+    };
+    let check = |model: &Rigid2, refine_config: &RefineConfig, origin: Origin| {
+        polished(&starts(model, origin), refine_config, origin)
+    };
+    // The placements of one whole-map search: every placement is searched, and when there are
+    // more than `refined_placements`, only those whose best start the maps agree with most
+    // are refined; the others are kept at that start, as verified there.
+    let check_placements = |models: &[Rigid2], origin: Origin| -> Vec<Candidate> {
+        let starts: Vec<Vec<Rigid2>> = models.par_iter().map(|m| starts(m, origin)).collect();
+        let refined_all = config.refined_placements.is_none_or(|k| models.len() <= k);
+        if refined_all {
+            return starts
+                .par_iter()
+                .map(|s| polished(s, &config.global_refine, origin))
+                .collect();
         }
+        let at_start: Vec<(Rigid2, Verification)> = starts
+            .par_iter()
+            .map(|s| {
+                best_of(
+                    s.iter()
+                        .map(|p| (*p, verify(&pa, &pb, p, &config.verify)))
+                        .collect(),
+                )
+            })
+            .collect();
+        let mut order: Vec<usize> = (0..models.len()).collect();
+        order.sort_by(|&i, &j| at_start[j].1.score().total_cmp(&at_start[i].1.score()));
+        let mut refine = vec![false; models.len()];
+        for &i in order
+            .iter()
+            .take(config.refined_placements.unwrap_or(usize::MAX))
+        {
+            refine[i] = true;
+        }
+        (0..models.len())
+            .into_par_iter()
+            .map(|i| {
+                if refine[i] {
+                    polished(&starts[i], &config.global_refine, origin)
+                } else {
+                    Candidate {
+                        refined: false,
+                        ..candidate(at_start[i], origin)
+                    }
+                }
+            })
+            .collect()
     };
     let mut candidates: Vec<Candidate> = hypotheses
         .par_iter()
@@ -699,13 +770,7 @@ fn register_as_given(
         let t0 = Instant::now();
         let mut models = Vec::new();
         generate(&mut models);
-        // Side by side: a check's own polishes are unequal (the turn search is the longest),
-        // so one check alone leaves a core idle. Collected in order, as a sequential map would.
-        let found: Vec<Candidate> = models
-            .par_iter()
-            .map(|m| check(m, &config.global_refine, origin))
-            .collect();
-        (found, ms(t0))
+        (check_placements(&models, origin), ms(t0))
     };
     if let Some(global) = &config.global
         && !candidates.iter().any(|c| c.accepted)
@@ -749,12 +814,24 @@ fn register_as_given(
         candidates.extend(found);
         timings.sweep_ms = t;
     }
-    let rank = |candidates: &mut Vec<Candidate>| {
+    // A whole-map placement kept where its search led, refined now that it matters.
+    let settle = |c: &mut Candidate| {
+        if !c.refined {
+            let scored = refine_and_score(&pa, &pb, &c.transform, &config.global_refine, config);
+            *c = candidate(scored, c.origin);
+        }
+    };
+    // Best first; the best is always a refined candidate.
+    let rank = |candidates: &mut Vec<Candidate>| loop {
         candidates.sort_by(|x, y| {
             y.accepted
                 .cmp(&x.accepted)
                 .then(y.verification.score().total_cmp(&x.verification.score()))
-        })
+        });
+        match candidates.first_mut() {
+            Some(best) if !best.refined => settle(best),
+            _ => break,
+        }
     };
     rank(&mut candidates);
     // How far apart two placements put B's walls, on average (the ambiguity test's and the
@@ -769,9 +846,16 @@ fn register_as_given(
     };
     // Nothing passed the bars: a placement may still stand out from every other (speckled
     // walls of a very noisy sensor). It is then probed for twins like any accepted answer.
+    let refined_standing_out = |candidates: &mut Vec<Candidate>, rule: &StandOut| loop {
+        let i = standing_out(candidates, rule, &config.verify, &apart)?;
+        if candidates[i].refined {
+            return Some(i);
+        }
+        settle(&mut candidates[i]);
+    };
     if let Some(rule) = &config.verify.stand_out
         && candidates.first().is_some_and(|c| !c.accepted)
-        && let Some(i) = standing_out(&candidates, rule, &config.verify, &apart)
+        && let Some(i) = refined_standing_out(&mut candidates, rule)
     {
         candidates[i].accepted = true;
         candidates[i].stands_out = true;
@@ -791,11 +875,7 @@ fn register_as_given(
             &config.global.unwrap_or_default(),
             &mut probes,
         );
-        let found: Vec<Candidate> = probes
-            .par_iter()
-            .map(|m| check(m, &config.global_refine, Origin::Symmetry))
-            .collect();
-        candidates.extend(found);
+        candidates.extend(check_placements(&probes, Origin::Symmetry));
         rank(&mut candidates);
         timings.symmetry_ms = ms(t0);
     }
@@ -1143,6 +1223,7 @@ mod tests {
             accepted: true,
             stands_out: false,
             origin: Origin::Symmetry,
+            refined: true,
         };
         let config = VerifyConfig::default();
         // The exact copy of a small room (a case proptest found): the best fits every wall,
@@ -1180,6 +1261,7 @@ mod tests {
             accepted: false,
             stands_out: false,
             origin: Origin::Sweep,
+            refined: true,
         };
         let apart = |x: &Rigid2, y: &Rigid2| (x.tx - y.tx).abs();
         let config = VerifyConfig::default();
@@ -1244,5 +1326,41 @@ mod tests {
             let err = displacement_error(&b, &best.transform, &truth).unwrap();
             assert!(err < 1.0, "probes {probes}: {err} px off");
         }
+    }
+
+    #[test]
+    fn refining_only_the_placements_that_fit_best_keeps_the_answer() {
+        // No keypoints: only the whole-map searches (global search, sweep) propose placements.
+        // Nor a last polish of the best, which would hide which placement was refined.
+        let a = room();
+        let (b, truth) = turned(&a);
+        let register = |refined_placements| {
+            let config = PairConfig {
+                refined_placements,
+                polish: None,
+                spectrum_rotation: None,
+                ..PairConfig::default()
+            };
+            register_with(&a, &b, &[], &config)
+        };
+        let all = register(None);
+        let one = register(Some(1));
+        // Every placement is still a candidate, most of them unrefined.
+        let sweep = |r: &Registration| {
+            let sweep = r.candidates.iter().filter(|c| c.origin == Origin::Sweep);
+            (sweep.clone().count(), sweep.filter(|c| c.refined).count())
+        };
+        let (proposed, refined) = sweep(&one);
+        assert_eq!(sweep(&all), (proposed, proposed));
+        assert!(
+            proposed > 4 && refined < proposed / 2,
+            "{refined} of {proposed} refined"
+        );
+        // The answer is refined, and the one refining every placement gives.
+        let (best, best_of_all) = (one.accepted.unwrap(), all.accepted.unwrap());
+        assert!(best.refined);
+        assert!(displacement_error(&b, &best.transform, &truth).unwrap() < 0.5);
+        let apart = displacement_error(&b, &best.transform, &best_of_all.transform).unwrap();
+        assert!(apart < 0.05, "{apart} px from refining all");
     }
 }
