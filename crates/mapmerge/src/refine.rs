@@ -51,7 +51,7 @@ pub struct RefineConfig {
     /// scoring takes a third of the time (`cargo bench -p mapmerge --bench register`,
     /// `refine_and_score_one_placement`: 8.5 -> 2.6-3.1 ms), and on the 30 % overlap rows and
     /// real floors of `cargo xtask eval` (seeds 7-9, both mappers; 640 pairs) 5 more pairs
-    /// were registered and 4 fewer accepted off the truth, while of 286 zero-overlap pairs
+    /// were registered and 4 fewer accepted off the truth, while of 281 zero-overlap pairs
     /// one more was accepted (5); see docs/EVALUATION.md, "ICP that stops once converged".
     pub tolerance_px: f64,
     /// Wall cells used per map while the gate shrinks (the first `max_iterations / 2`
