@@ -42,17 +42,18 @@ pub struct RefineConfig {
     /// map) refine proportionally faster.
     pub max_points: usize,
     /// The refinement has converged (once the gate has shrunk) when an iteration moves the
-    /// paired walls by less than this, in pixels (translation plus rotation times the pairs'
-    /// root-mean-square distance from their centroid), and each range-bias offset by less.
-    /// Default 0.05. The test before it (a step under 0.001 px and 0.00001 rad) was almost
-    /// never met: with the Cauchy weight at 0.15 px the fit creeps by about 0.03 px per
-    /// iteration, and 101 of the 114 refinements of the 2048 x 2048 bench's hard pair ran all
-    /// their iterations. With this and [`RefineConfig::coarse_points`] one refinement and
-    /// scoring takes a third of the time (`cargo bench -p mapmerge --bench register`,
-    /// `refine_and_score_one_placement`: 8.5 -> 2.6-3.1 ms), and on the 30 % overlap rows and
-    /// real floors of `cargo xtask eval` (seeds 7-9, both mappers; 640 pairs) 5 more pairs
-    /// were registered and 4 fewer accepted off the truth, while of 281 zero-overlap pairs
-    /// one more was accepted (5); see docs/EVALUATION.md, "ICP that stops once converged".
+    /// paired walls by less than this, in pixels (translation plus rotation times the
+    /// pairs' root-mean-square distance from their centroid), and each range-bias offset by
+    /// less. Default 0.05. The test before it (a step under 0.001 px and 0.00001 rad) was
+    /// almost never met: with the Cauchy weight at 0.15 px the fit creeps by about 0.03 px
+    /// per iteration, and 101 of the 114 refinements of the 2048 x 2048 bench's hard pair
+    /// ran all their iterations (a scratch count, 2026-12-03). With this and
+    /// [`RefineConfig::coarse_points`] one refinement and scoring takes a third of the time
+    /// (`cargo bench -p mapmerge --bench register`, `refine_and_score_one_placement`: 8.5
+    /// -> 2.6-3.1 ms), and on the 30 % overlap rows and real floors of `cargo xtask eval`
+    /// (seeds 7-9, both mappers; 640 pairs) 5 more pairs were registered and 4 fewer
+    /// accepted off the truth, while of 281 zero-overlap pairs one more was accepted (5);
+    /// see docs/EVALUATION.md, "ICP that stops once converged".
     pub tolerance_px: f64,
     /// Wall cells used per map while the gate shrinks (the first `max_iterations / 2`
     /// iterations, evenly strided from the `max_points`); the iterations after that, which
