@@ -403,16 +403,20 @@ pub fn refine_with_bias(
             ty: c.y - step.apply(c).y + dy,
         };
         t = about_c.compose(&t);
-        // How far the step moved the paired walls (root mean square; offsets count as moves).
-        let spread = (pairs
-            .iter()
-            .map(|pr| (t.apply(pr.p) - c).length_squared())
-            .sum::<f64>()
-            / pairs.len() as f64)
-            .sqrt();
-        if dx.hypot(dy) + dt.abs() * spread < config.tolerance_px
+        // Converged once the gate has shrunk and the step moved the paired walls (root mean
+        // square about `c`) and the offsets by less than the tolerance. The spread is only
+        // computed where the test can pass.
+        let spread = || {
+            (pairs
+                .iter()
+                .map(|pr| (t.apply(pr.p) - c).length_squared())
+                .sum::<f64>()
+                / pairs.len() as f64)
+                .sqrt()
+        };
+        if f >= 1.0
             && moved < config.tolerance_px
-            && f >= 1.0
+            && dx.hypot(dy) + dt.abs() * spread() < config.tolerance_px
         {
             break;
         }
