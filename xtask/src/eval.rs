@@ -179,6 +179,11 @@ pub struct EvalArgs {
     /// experiments.
     #[arg(long)]
     search_sigma: Option<f64>,
+    /// Override how many wall cells per map the correlative local search compares on its finer
+    /// levels, for both its searches (`mapmerge::search::SearchConfig::max_points`; default:
+    /// the library's), for calibration experiments.
+    #[arg(long)]
+    search_points: Option<usize>,
     /// Override how many wall cells per map every ICP refinement pairs while its gate shrinks
     /// (`mapmerge::refine::RefineConfig::coarse_points`; default: the library's). A number
     /// at least `max_points` (6000) uses all of them throughout, as before the coarse phase.
@@ -599,6 +604,14 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
             .flatten()
         {
             search.sigma_px = px;
+        }
+    }
+    if let Some(n) = args.search_points {
+        for search in [&mut config.pair.search, &mut config.pair.turn_search]
+            .into_iter()
+            .flatten()
+        {
+            search.max_points = n;
         }
     }
     for refine in [&mut config.pair.refine, &mut config.pair.global_refine]

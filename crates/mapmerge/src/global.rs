@@ -11,6 +11,7 @@
 use std::f64::consts::PI;
 
 use grid_core::{CellState, DVec2, Rigid2};
+use rayon::prelude::*;
 use rustfft::FftPlanner;
 use rustfft::num_complex::Complex32;
 
@@ -471,21 +472,27 @@ pub fn global_hypotheses(
         angles.push(base);
         angles.push(base + PI);
     }
-    let mut planner = FftPlanner::<f32>::new();
     let field = CoarseField::new(
         a,
         b,
         config.coarse_size,
         config.free_penalty,
         false,
-        &mut planner,
+        &mut FftPlanner::new(),
     );
-    let mut buf = Vec::new();
-    for theta in angles {
-        let (found, _) =
-            field.correlate(&pb, theta, config.translation_peaks, &mut planner, &mut buf);
-        out.extend(found.into_iter().map(|(_, t)| t));
-    }
+    // The angles' correlations are independent: side by side, collected in order.
+    let found: Vec<Vec<Rigid2>> = angles
+        .par_iter()
+        .map_init(
+            || (FftPlanner::<f32>::new(), Vec::new()),
+            |(planner, buf), &theta| {
+                let (found, _) =
+                    field.correlate(&pb, theta, config.translation_peaks, planner, buf);
+                found.into_iter().map(|(_, t)| t).collect()
+            },
+        )
+        .collect();
+    out.extend(found.into_iter().flatten());
 }
 
 /// Append the twins of placement `b_to_a` to `out`: for its angle, and its angle plus a
@@ -502,7 +509,6 @@ pub fn twins(
     config: &GlobalConfig,
     out: &mut Vec<Rigid2>,
 ) {
-    use rayon::prelude::*;
     let pb = strided(&b.wall_samples, config.max_points);
     if pb.len() < 10 || a.wall_samples.len() < 10 {
         return;
@@ -673,7 +679,6 @@ pub fn sweep_placements(
     config: &SweepConfig,
     normalized_count: usize,
 ) -> SweepPlacements {
-    use rayon::prelude::*;
     let pb = strided(&b.wall_samples, config.max_points);
     if pb.len() < 10
         || a.wall_samples.len() < 10

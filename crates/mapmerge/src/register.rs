@@ -510,37 +510,60 @@ pub fn refine_and_score(
     (transform, v)
 }
 
+/// A whole-map placement, and where the translation-only local search (`PairConfig::search`)
+/// moved it when that is already known (the screen searched it), so that it is not searched
+/// twice.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Placement {
+    pose: Rigid2,
+    searched: Option<Rigid2>,
+}
+
+impl Placement {
+    /// A placement not searched yet.
+    fn unsearched(pose: Rigid2) -> Self {
+        Self {
+            pose,
+            searched: None,
+        }
+    }
+}
+
 /// The `keep` of `placements` that the maps agree with most once the correlative local search
 /// (`config.search`, if any) has moved them: a cheap screen before the full refinement, for a
 /// coarse ranking that puts the truth too far down (see [`SweepConfig::screened`]). Returns
-/// the placements themselves, best screened first; all of them, in order, when there are no
-/// more than `keep`. Deterministic: ties keep the given order.
+/// the placements themselves with where the search moved them, best screened first; all of
+/// them, in order and unsearched, when there are no more than `keep`. Deterministic: ties
+/// keep the given order.
 fn screen(
     a: &PreparedMap,
     b: &PreparedMap,
     placements: Vec<Rigid2>,
     keep: usize,
     config: &PairConfig,
-) -> Vec<Rigid2> {
+) -> Vec<Placement> {
     if placements.len() <= keep {
-        return placements;
+        return placements.into_iter().map(Placement::unsearched).collect();
     }
-    let scores: Vec<f64> = placements
+    let scored: Vec<(Rigid2, f64)> = placements
         .par_iter()
         .map(|p| {
             let moved = config
                 .search
                 .as_ref()
                 .map_or(*p, |sc| local_search(a, b, p, sc));
-            verify(a, b, &moved, &config.verify).score()
+            (moved, verify(a, b, &moved, &config.verify).score())
         })
         .collect();
     let mut order: Vec<usize> = (0..placements.len()).collect();
-    order.sort_by(|&i, &j| scores[j].total_cmp(&scores[i]));
+    order.sort_by(|&i, &j| scored[j].1.total_cmp(&scored[i].1));
     order
         .into_iter()
         .take(keep)
-        .map(|i| placements[i])
+        .map(|i| Placement {
+            pose: placements[i],
+            searched: Some(scored[i].0),
+        })
         .collect()
 }
 
@@ -653,7 +676,8 @@ fn register_as_given(
     //
     // `starts` gives the poses a hypothesis is refined from, `polished` refines them and
     // keeps the best.
-    let starts = |model: &Rigid2, origin: Origin| -> Vec<Rigid2> {
+    let starts = |placement: &Placement, origin: Origin| -> Vec<Rigid2> {
+        let model = &placement.pose;
         // Whole-map placements are also searched over rotation.
         let turn_search = if origin == Origin::Ransac {
             None
@@ -666,7 +690,10 @@ fn register_as_given(
         };
         // The searches are independent: run them side by side.
         let (searched, turned) = rayon::join(
-            || searched(config.search.as_ref()),
+            || match placement.searched {
+                Some(moved) => (moved != *model).then_some(moved),
+                None => searched(config.search.as_ref()),
+            },
             || searched(turn_search),
         );
         let from_itself = turn_search.is_none()
@@ -708,12 +735,16 @@ fn register_as_given(
         candidate(best_of(scored), origin)
     };
     let check = |model: &Rigid2, refine_config: &RefineConfig, origin: Origin| {
-        polished(&starts(model, origin), refine_config, origin)
+        polished(
+            &starts(&Placement::unsearched(*model), origin),
+            refine_config,
+            origin,
+        )
     };
     // The placements of one whole-map search: every placement is searched, and when there are
     // more than `refined_placements`, only those whose best start the maps agree with most
     // are refined; the others are kept at that start, as verified there.
-    let check_placements = |models: &[Rigid2], origin: Origin| -> Vec<Candidate> {
+    let check_placements = |models: &[Placement], origin: Origin| -> Vec<Candidate> {
         let starts: Vec<Vec<Rigid2>> = models.par_iter().map(|m| starts(m, origin)).collect();
         let refined_all = config.refined_placements.is_none_or(|k| models.len() <= k);
         if refined_all {
@@ -766,7 +797,7 @@ fn register_as_given(
     timings.verify_ms = ms(t0);
     // The whole-map searches: their placements are checked like the feature-based ones, with
     // the global refinement (they come from a coarse grid).
-    let search = |generate: &dyn Fn(&mut Vec<Rigid2>), origin: Origin| {
+    let search = |generate: &dyn Fn(&mut Vec<Placement>), origin: Origin| {
         let t0 = Instant::now();
         let mut models = Vec::new();
         generate(&mut models);
@@ -776,7 +807,11 @@ fn register_as_given(
         && !candidates.iter().any(|c| c.accepted)
     {
         let (found, t) = search(
-            &|out| global_hypotheses(&pa, &pb, global, out),
+            &|out| {
+                let mut found = Vec::new();
+                global_hypotheses(&pa, &pb, global, &mut found);
+                out.extend(found.into_iter().map(Placement::unsearched));
+            },
             Origin::Global,
         );
         candidates.extend(found);
@@ -800,7 +835,7 @@ fn register_as_given(
             &|out| {
                 let found =
                     sweep_placements(&pa, &pb, sweep, sweep.screened.max(sweep.keep_normalized));
-                out.extend(found.plain);
+                out.extend(found.plain.into_iter().map(Placement::unsearched));
                 out.extend(screen(
                     &pa,
                     &pb,
@@ -875,6 +910,7 @@ fn register_as_given(
             &config.global.unwrap_or_default(),
             &mut probes,
         );
+        let probes: Vec<Placement> = probes.into_iter().map(Placement::unsearched).collect();
         candidates.extend(check_placements(&probes, Origin::Symmetry));
         rank(&mut candidates);
         timings.symmetry_ms = ms(t0);
@@ -1199,11 +1235,18 @@ mod tests {
         ];
         let config = PairConfig::default();
         let placements = vec![wrong[0], wrong[1], near, wrong[2]];
-        assert_eq!(screen(&pa, &pb, placements.clone(), 1, &config), vec![near]);
+        let poses = |kept: Vec<Placement>| kept.iter().map(|p| p.pose).collect::<Vec<_>>();
+        let one = screen(&pa, &pb, placements.clone(), 1, &config);
+        assert_eq!(poses(one.clone()), vec![near]);
+        // The screen hands over where it searched the placement: what the search gives.
+        let searched = local_search(&pa, &pb, &near, &config.search.unwrap());
+        assert_eq!(one[0].searched, Some(searched));
         let two = screen(&pa, &pb, placements.clone(), 2, &config);
-        assert_eq!((two.len(), two[0]), (2, near));
+        assert_eq!((two.len(), two[0].pose), (2, near));
         // No more placements than kept: all of them, in their order, unscreened.
-        assert_eq!(screen(&pa, &pb, placements.clone(), 4, &config), placements);
+        let all = screen(&pa, &pb, placements.clone(), 4, &config);
+        assert_eq!(poses(all.clone()), placements);
+        assert!(all.iter().all(|p| p.searched.is_none()));
     }
 
     #[test]

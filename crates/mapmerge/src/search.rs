@@ -119,6 +119,19 @@ fn shifted_score(turned: &[DVec2], onto: &PreparedMap, shift: DVec2, k: &Kernel)
     s
 }
 
+/// [`shifted_score`] for each of `shifts`, in order, with the same sums (each adds the points
+/// in order). Point by point rather than shift by shift: the cells one point visits over the
+/// shifts lie close together, so they stay in the nearest cache.
+fn shifted_scores(turned: &[DVec2], onto: &PreparedMap, shifts: &[DVec2], k: &Kernel) -> Vec<f32> {
+    let mut sums = vec![0.0f32; shifts.len()];
+    for &r in turned {
+        for (s, &shift) in sums.iter_mut().zip(shifts) {
+            *s += k.at(onto.known_wall_quarters(r + shift));
+        }
+    }
+    sums
+}
+
 /// `points` turned by `theta`.
 fn turned(points: &[DVec2], theta: f64) -> Vec<DVec2> {
     let rot = DVec2::from_angle(theta);
@@ -175,6 +188,10 @@ pub fn local_search(
         let coarse = level == 0;
         let (sa, sb) = if coarse { (&ca, &cb) } else { (&pa, &pb) };
         let (theta0, d0) = best;
+        let offsets: Vec<DVec2> = (-n_t..=n_t)
+            .flat_map(|iy| (-n_t..=n_t).map(move |ix| DVec2::new(ix as f64, iy as f64)))
+            .map(|o| d0 + o * step)
+            .collect();
         for ia in -n_a..=n_a {
             let dtheta = theta0 + ia as f64 * astep;
             // Every pose at this angle turns the points alike (a pose's angle does not depend
@@ -184,18 +201,20 @@ pub fn local_search(
                 turned(sb, at_angle.theta),
                 turned(sa, at_angle.inverse().theta),
             );
-            for iy in -n_t..=n_t {
-                for ix in -n_t..=n_t {
-                    let d = d0 + DVec2::new(ix as f64, iy as f64) * step;
-                    let t = pose(dtheta, d);
-                    let s = shifted_score(&tb, a, t.translation(), &kernel)
-                        + shifted_score(&ta, b, t.inverse().translation(), &kernel);
-                    // Strictly better only: on a plateau the hypothesis (or the earlier pose)
-                    // stays, which keeps the result independent of the grid's visiting order.
-                    if s > best_score {
-                        best_score = s;
-                        best = (dtheta, d);
-                    }
+            let poses: Vec<Rigid2> = offsets.iter().map(|&d| pose(dtheta, d)).collect();
+            let shifts_b: Vec<DVec2> = poses.iter().map(|t| t.translation()).collect();
+            let shifts_a: Vec<DVec2> = poses.iter().map(|t| t.inverse().translation()).collect();
+            let (sums_b, sums_a) = (
+                shifted_scores(&tb, a, &shifts_b, &kernel),
+                shifted_scores(&ta, b, &shifts_a, &kernel),
+            );
+            for (k, &d) in offsets.iter().enumerate() {
+                let s = sums_b[k] + sums_a[k];
+                // Strictly better only: on a plateau the hypothesis (or the earlier pose)
+                // stays, which keeps the result independent of the grid's visiting order.
+                if s > best_score {
+                    best_score = s;
+                    best = (dtheta, d);
                 }
             }
         }
