@@ -51,10 +51,11 @@ pub struct EvalArgs {
     /// Skip the symmetry probes of the best candidate (to measure what they add).
     #[arg(long)]
     no_symmetry: bool,
-    /// Skip the global search (Hough spectrum and correlation) that runs when no feature-based
-    /// candidate passed, leaving the rotation sweep (to measure what it adds).
+    /// Also run the global search (Hough spectrum and correlation; `mapmerge::PairConfig::global`,
+    /// off by default since 2026-12-04) when no feature-based candidate passed, besides the
+    /// rotation sweep (to measure what it adds).
     #[arg(long)]
-    no_global: bool,
+    global: bool,
     /// Score candidates without their range-bias offsets (to measure what they add).
     #[arg(long)]
     no_offset_scoring: bool,
@@ -121,7 +122,8 @@ pub struct EvalArgs {
     #[arg(long)]
     sweep_free_penalty: Option<f32>,
     /// Override the same charge for the Hough search and the symmetry probes (default: the
-    /// library's), for calibration experiments.
+    /// library's), for calibration experiments. Needs `--global`: the probes take the global
+    /// search's settings when it is on, and the defaults when it is off.
     #[arg(long)]
     global_free_penalty: Option<f32>,
     /// Rank the rotation sweep's placements by their normalised correlation (see
@@ -545,8 +547,8 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
     if args.no_symmetry {
         config.pair.symmetry_probes = false;
     }
-    if args.no_global {
-        config.pair.global = None;
+    if args.global {
+        config.pair.global = Some(mapmerge::global::GlobalConfig::default());
     }
     if args.no_search {
         config.pair.search = None;

@@ -7,7 +7,7 @@
 //! `end_to_end_partial_maps`: two simulated robots' partial maps of the same floor (10 % and
 //! 20 % range noise, half of each map shared: case 7_014_000 of `cargo xtask eval --suites
 //! overlap,zero,paper,real,noise --seed 7`), each on a 2048 x 2048 canvas. Few keypoints agree
-//! there, so the global search, the rotation sweep and the symmetry probes run: the hard case.
+//! there, so the rotation sweep and the symmetry probes run: the hard case.
 //!
 //! `end_to_end_overlapping_crops`: two crops of the same floor, the western three quarters
 //! and the eastern three quarters (half of the floor's width shared), the second turned by 30
@@ -16,11 +16,11 @@
 //!
 //! `partial_maps/*`: the stages that dominate that hard pair, each on its own, on the same
 //! pair framed (`PairConfig::frame`) and prepared once: the rotation sweep
-//! (`sweep_placements`), the Hough-spectrum and correlation search (`global_hypotheses`), one
+//! (`sweep_placements`), the symmetry probes' correlations of one placement (`twins`), one
 //! correlative local search over +-2 degrees (the turn search each whole-map placement gets),
 //! one refinement and scoring of a placement (`refine_and_score`: ICP with the range-bias
 //! offsets, then verification) and one verification alone. The end-to-end time is about one
-//! sweep and one global search plus a few dozen placements each searched, refined and scored
+//! sweep and the probes' correlations plus a few dozen placements each searched, refined and scored
 //! (see `timings_ms` of `mapmerge estimate --json`).
 //!
 //! Run: `cargo bench -p mapmerge --bench register`.
@@ -28,7 +28,7 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use grid_core::io::{LoadOptions, load_map};
 use grid_core::{CorrespondenceSource, OccupancyGrid, Rigid2, UNKNOWN};
-use mapmerge::global::{global_hypotheses, sweep_placements};
+use mapmerge::global::{sweep_placements, twins};
 use mapmerge::search::local_search;
 use mapmerge::verify::{PreparedMap, VerifyConfig, verify};
 use mapmerge::{RegisterConfig, refine_and_score, register};
@@ -155,9 +155,9 @@ fn bench(c: &mut Criterion) {
         PreparedMap::new(&fb, &pair_config.verify),
     );
     let sweep = pair_config.sweep.expect("the default runs the sweep");
-    let global = pair_config
-        .global
-        .expect("the default runs the global search");
+    // The symmetry probes take the global search's settings, or their defaults when it is off
+    // (the default).
+    let global = pair_config.global.unwrap_or_default();
     let turn = pair_config
         .turn_search
         .expect("the default searches whole-map placements over rotation");
@@ -171,10 +171,10 @@ fn bench(c: &mut Criterion) {
     g.bench_function("rotation_sweep", |bn| {
         bn.iter(|| sweep_placements(&ppa, &ppb, &sweep, normalized))
     });
-    g.bench_function("global_search", |bn| {
+    g.bench_function("symmetry_twins", |bn| {
         bn.iter(|| {
             let mut out = Vec::new();
-            global_hypotheses(&ppa, &ppb, &global, &mut out);
+            twins(&ppa, &ppb, &start, &global, &mut out);
             out
         })
     });
