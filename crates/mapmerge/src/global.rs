@@ -381,40 +381,58 @@ fn local_maxima(score: &[f32], w: usize, h: usize, peaks: usize) -> Vec<(f32, us
         return found;
     }
     let wrap = |t: usize, d: i64, n: usize| (t as i64 + d).rem_euclid(n as i64) as usize;
+    // Only a value above the worst kept can enter (ties keep the earlier one).
+    let enters = |v: f32, found: &[(f32, usize, usize)]| {
+        v > 0.0 && (found.len() < peaks || v > found[peaks - 1].0)
+    };
+    // A row is read a run of cells at a time, and a run whose largest value cannot enter is
+    // skipped whole (most are, once `peaks` maxima are kept): the same cells enter.
+    const RUN: usize = 32;
     for ty in 0..h {
         let inner_row = ty > 0 && ty + 1 < h;
-        for tx in 0..w {
-            let v = score[ty * w + tx];
-            // Only a value above the worst kept can enter (ties keep the earlier one).
-            if v <= 0.0 || (found.len() == peaks && v <= found[peaks - 1].0) {
+        let row = &score[ty * w..(ty + 1) * w];
+        for x0 in (0..w).step_by(RUN) {
+            let end = (x0 + RUN).min(w);
+            let top = row[x0..end]
+                .iter()
+                .copied()
+                .fold(f32::NEG_INFINITY, f32::max);
+            if !enters(top, &found) {
                 continue;
             }
-            let is_max = if inner_row && tx > 0 && tx + 1 < w {
-                // Away from the borders the neighbours need no wrapping.
-                let i = ty * w + tx;
-                [
-                    i - w - 1,
-                    i - w,
-                    i - w + 1,
-                    i - 1,
-                    i + 1,
-                    i + w - 1,
-                    i + w,
-                    i + w + 1,
-                ]
-                .iter()
-                .all(|&j| score[j] <= v)
-            } else {
-                (-1i64..=1).all(|dy| {
-                    (-1i64..=1).all(|dx| {
-                        (dx == 0 && dy == 0) || score[wrap(ty, dy, h) * w + wrap(tx, dx, w)] <= v
+            for tx in x0..end {
+                let v = row[tx];
+                if !enters(v, &found) {
+                    continue;
+                }
+                let is_max = if inner_row && tx > 0 && tx + 1 < w {
+                    // Away from the borders the neighbours need no wrapping.
+                    let i = ty * w + tx;
+                    [
+                        i - w - 1,
+                        i - w,
+                        i - w + 1,
+                        i - 1,
+                        i + 1,
+                        i + w - 1,
+                        i + w,
+                        i + w + 1,
+                    ]
+                    .iter()
+                    .all(|&j| score[j] <= v)
+                } else {
+                    (-1i64..=1).all(|dy| {
+                        (-1i64..=1).all(|dx| {
+                            (dx == 0 && dy == 0)
+                                || score[wrap(ty, dy, h) * w + wrap(tx, dx, w)] <= v
+                        })
                     })
-                })
-            };
-            if is_max {
-                let at = found.partition_point(|f| f.0 >= v);
-                found.insert(at, (v, tx, ty));
-                found.truncate(peaks);
+                };
+                if is_max {
+                    let at = found.partition_point(|f| f.0 >= v);
+                    found.insert(at, (v, tx, ty));
+                    found.truncate(peaks);
+                }
             }
         }
     }
@@ -747,6 +765,44 @@ mod tests {
     use super::*;
     use crate::testmaps::room;
     use crate::verify::VerifyConfig;
+
+    #[test]
+    fn the_local_maxima_are_those_of_a_cell_by_cell_scan() {
+        // A width that is not a multiple of the runs, ties, negative and zero cells, and
+        // maxima on the wrapped borders; against every maximum, stably sorted and truncated.
+        let (w, h) = (75, 41);
+        let mut state = 12345u64;
+        let score: Vec<f32> = (0..w * h)
+            .map(|_| {
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                ((state >> 33) % 23) as f32 - 6.0
+            })
+            .collect();
+        let at = |x: i64, y: i64| {
+            score[y.rem_euclid(h as i64) as usize * w + x.rem_euclid(w as i64) as usize]
+        };
+        let mut all = Vec::new();
+        for y in 0..h as i64 {
+            for x in 0..w as i64 {
+                let v = at(x, y);
+                let neighbours = (-1..=1).flat_map(|dy| (-1..=1).map(move |dx| (dx, dy)));
+                if v > 0.0
+                    && neighbours
+                        .filter(|&d| d != (0, 0))
+                        .all(|(dx, dy)| at(x + dx, y + dy) <= v)
+                {
+                    all.push((v, x as usize, y as usize));
+                }
+            }
+        }
+        all.sort_by(|p, q| q.0.total_cmp(&p.0));
+        for peaks in [0, 1, 5, 40, 10_000] {
+            let expected: Vec<_> = all.iter().copied().take(peaks).collect();
+            assert_eq!(local_maxima(&score, w, h, peaks), expected, "{peaks} peaks");
+        }
+    }
 
     #[test]
     fn the_sweep_finds_a_turned_copy_and_is_deterministic() {
