@@ -206,6 +206,23 @@ fn fft2(
     }
 }
 
+/// The smallest length at least `n` whose only prime factors are 2, 3 and 5: transforms of
+/// such lengths are about as fast per sample as those of powers of two, and the next power of
+/// two can be nearly twice as long (the correlation images' area up to four times as large).
+fn fft_len(n: usize) -> usize {
+    (n.max(1)..)
+        .find(|&m| {
+            let mut m = m;
+            for p in [2, 3, 5] {
+                while m % p == 0 {
+                    m /= p;
+                }
+            }
+            m == 1
+        })
+        .expect("a 5-smooth number follows every n")
+}
+
 /// A placement with its correlation.
 type Scored = (f32, Rigid2);
 
@@ -253,10 +270,7 @@ impl CoarseField {
             (ha / scale).ceil() as usize + 1,
         );
         let bside = (diag_b / scale).ceil() as usize + 2;
-        let (nw, nh) = (
-            (cw + bside).next_power_of_two(),
-            (ch + bside).next_power_of_two(),
-        );
+        let (nw, nh) = (fft_len(cw + bside), fft_len(ch + bside));
         let (field, known) = coarse_field(a, scale, cw, ch, free_penalty);
         let mut spectrum = vec![Complex32::default(); nw * nh];
         for y in 0..ch {
@@ -765,6 +779,36 @@ mod tests {
     use super::*;
     use crate::testmaps::room;
     use crate::verify::VerifyConfig;
+
+    #[test]
+    fn correlation_images_take_the_next_length_of_factors_2_3_and_5() {
+        let smooth = |m: usize| {
+            let mut m = m;
+            for p in [2, 3, 5] {
+                while m % p == 0 {
+                    m /= p;
+                }
+            }
+            m == 1
+        };
+        for (n, len) in [
+            (1, 1),
+            (7, 8),
+            (97, 100),
+            (129, 135),
+            (193, 200),
+            (257, 270),
+        ] {
+            assert_eq!(fft_len(n), len, "{n}");
+        }
+        for n in 1..2000 {
+            let len = fft_len(n);
+            assert!(
+                len >= n && smooth(len) && (n..len).all(|m| !smooth(m)),
+                "{n} -> {len}"
+            );
+        }
+    }
 
     #[test]
     fn the_local_maxima_are_those_of_a_cell_by_cell_scan() {
