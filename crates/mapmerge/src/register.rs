@@ -519,12 +519,12 @@ pub fn refine_and_score(
 }
 
 /// A whole-map placement, and where the translation-only local search (`PairConfig::search`)
-/// moved it when that is already known (the screen searched it), so that it is not searched
-/// twice.
+/// moved it and how that pose verified, when that is already known (the screen searched and
+/// verified it), so that it is not searched and verified twice.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Placement {
     pose: Rigid2,
-    searched: Option<Rigid2>,
+    searched: Option<(Rigid2, Verification)>,
 }
 
 impl Placement {
@@ -553,24 +553,24 @@ fn screen(
     if placements.len() <= keep {
         return placements.into_iter().map(Placement::unsearched).collect();
     }
-    let scored: Vec<(Rigid2, f64)> = placements
+    let scored: Vec<(Rigid2, Verification)> = placements
         .par_iter()
         .map(|p| {
             let moved = config
                 .search
                 .as_ref()
                 .map_or(*p, |sc| local_search(a, b, p, sc));
-            (moved, verify(a, b, &moved, &config.verify).score())
+            (moved, verify(a, b, &moved, &config.verify))
         })
         .collect();
     let mut order: Vec<usize> = (0..placements.len()).collect();
-    order.sort_by(|&i, &j| scored[j].1.total_cmp(&scored[i].1));
+    order.sort_by(|&i, &j| scored[j].1.score().total_cmp(&scored[i].1.score()));
     order
         .into_iter()
         .take(keep)
         .map(|i| Placement {
             pose: placements[i],
-            searched: Some(scored[i].0),
+            searched: Some(scored[i]),
         })
         .collect()
 }
@@ -699,7 +699,7 @@ fn register_as_given(
         // The searches are independent: run them side by side.
         let (searched, turned) = rayon::join(
             || match placement.searched {
-                Some(moved) => (moved != *model).then_some(moved),
+                Some((moved, _)) => (moved != *model).then_some(moved),
                 None => searched(config.search.as_ref()),
             },
             || searched(turn_search),
@@ -761,12 +761,17 @@ fn register_as_given(
                 .map(|s| polished(s, &config.global_refine, origin))
                 .collect();
         }
+        // A start the screen verified is not verified again.
         let at_start: Vec<(Rigid2, Verification)> = starts
             .par_iter()
-            .map(|s| {
+            .zip(models)
+            .map(|(s, m)| {
                 best_of(
                     s.iter()
-                        .map(|p| (*p, verify(&pa, &pb, p, &config.verify)))
+                        .map(|p| match m.searched {
+                            Some((q, v)) if q == *p => (*p, v),
+                            _ => (*p, verify(&pa, &pb, p, &config.verify)),
+                        })
                         .collect(),
                 )
             })
@@ -1248,7 +1253,8 @@ mod tests {
         assert_eq!(poses(one.clone()), vec![near]);
         // The screen hands over where it searched the placement: what the search gives.
         let searched = local_search(&pa, &pb, &near, &config.search.unwrap());
-        assert_eq!(one[0].searched, Some(searched));
+        let verified = verify(&pa, &pb, &searched, &config.verify);
+        assert_eq!(one[0].searched, Some((searched, verified)));
         let two = screen(&pa, &pb, placements.clone(), 2, &config);
         assert_eq!((two.len(), two[0].pose), (2, near));
         // No more placements than kept: all of them, in their order, unscreened.
