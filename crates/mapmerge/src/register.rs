@@ -1248,9 +1248,9 @@ mod tests {
         ];
         let config = PairConfig::default();
         let placements = vec![wrong[0], wrong[1], near, wrong[2]];
-        let poses = |kept: Vec<Placement>| kept.iter().map(|p| p.pose).collect::<Vec<_>>();
+        let poses = |kept: &[Placement]| kept.iter().map(|p| p.pose).collect::<Vec<_>>();
         let one = screen(&pa, &pb, placements.clone(), 1, &config);
-        assert_eq!(poses(one.clone()), vec![near]);
+        assert_eq!(poses(&one), vec![near]);
         // The screen hands over where it searched the placement: what the search gives.
         let searched = local_search(&pa, &pb, &near, &config.search.unwrap());
         let verified = verify(&pa, &pb, &searched, &config.verify);
@@ -1259,7 +1259,7 @@ mod tests {
         assert_eq!((two.len(), two[0].pose), (2, near));
         // No more placements than kept: all of them, in their order, unscreened.
         let all = screen(&pa, &pb, placements.clone(), 4, &config);
-        assert_eq!(poses(all.clone()), placements);
+        assert_eq!(poses(&all), placements);
         assert!(all.iter().all(|p| p.searched.is_none()));
     }
 
