@@ -20,8 +20,8 @@
 //! correlative local search over +-2 degrees (the turn search each whole-map placement gets),
 //! one refinement and scoring of a placement (`refine_and_score`: ICP with the range-bias
 //! offsets, then verification) and one verification alone. The end-to-end time is about one
-//! sweep and the probes' correlations plus a few dozen placements each searched, refined and scored
-//! (see `timings_ms` of `mapmerge estimate --json`).
+//! sweep and the probes' correlations plus a few dozen placements each searched, refined and
+//! scored (see `timings_ms` of `mapmerge estimate --json`).
 //!
 //! Run: `cargo bench -p mapmerge --bench register`.
 
