@@ -7,6 +7,11 @@
 //! the translation is where B's rotated walls best hit A's wall likelihood field (an FFT
 //! cross-correlation at a coarse scale). The hypotheses go through the same refinement and
 //! verification as the feature-based ones, so a wrong one costs time, not trust.
+//!
+//! That Hough-spectrum search ([`global_hypotheses`]) runs only when `PairConfig::global` is
+//! on (off by default: the rotation sweep proposes what it does). The same FFT correlation
+//! serves the rotation sweep ([`sweep_placements`]: every 2 degrees of a full turn) and the
+//! symmetry probes ([`twins`]), which the default pipeline runs.
 
 use std::f64::consts::PI;
 

@@ -58,13 +58,14 @@ pub struct PairConfig {
     /// fit (see [`SweepConfig::confident_wall_lift`]); `None` disables it. Default: on,
     /// [`SweepConfig::default`].
     pub sweep: Option<SweepConfig>,
-    /// Refinement of global-search candidates: a wider first gate, since they come from a
-    /// coarse grid. Default: gate 12 px shrinking to 2 px, at most 24 px of movement.
+    /// Refinement of the whole-map searches' placements (the sweep, the symmetry probes, and
+    /// the global search when it is on): a wider first gate, since they come from a coarse
+    /// grid. Default: gate 12 px shrinking to 2 px, at most 24 px of movement.
     pub global_refine: RefineConfig,
     /// Symmetry probes of the best accepted candidate: at its angle, and its angle turned by a
     /// quarter, a half and three quarters of a turn, the best translations are found by
     /// correlation ([`crate::global::twins`], with the `global` settings or their
-    /// defaults), and each twin is refined and verified like a global-search candidate. A
+    /// defaults), and each twin is refined and verified like a sweep placement. A
     /// row of alike rooms, or a room or rubble field that looks the same turned, fits a twin
     /// about as well, and a twin that fits about as well as the best makes the pair ambiguous
     /// (the rule of [`VerifyConfig::max_ambiguity`], including its contradiction gate): it is
@@ -675,7 +676,7 @@ fn register_as_given(
 
     let t0 = Instant::now();
     // Each hypothesis is polished by ICP, once from itself and once from the best pose of the
-    // correlative local search around it (keypoints, or the global search's coarse grid, can
+    // correlative local search around it (keypoints, or a whole-map search's coarse grid, can
     // put it a few pixels off, outside ICP's narrow basin), and for whole-map placements once
     // more from the best pose of the turn search; the polished pose the maps agree with most
     // wins (the first of equals). A whole-map placement is refined from itself only when
@@ -1387,7 +1388,8 @@ mod tests {
 
     #[test]
     fn refining_only_the_placements_that_fit_best_keeps_the_answer() {
-        // No keypoints: only the whole-map searches (global search, sweep) propose placements.
+        // No keypoints: only the whole-map searches (the sweep and the symmetry probes; the
+        // global search is off by default) propose placements.
         // Nor a last polish of the best, which would hide which placement was refined.
         let a = room();
         let (b, truth) = turned(&a);

@@ -2,7 +2,7 @@
 //! pixels before ICP polishes it.
 //!
 //! A hypothesis is fixed by a handful of keypoints located to a few pixels on a noisy map (or,
-//! from the global search, by a coarse grid); ICP with a small robust scale (see
+//! from a whole-map search, by a coarse grid); ICP with a small robust scale (see
 //! [`crate::refine`]) keeps a good pose exactly but cannot pull a pose that starts 4-6 px off,
 //! because near such a pose no wall pairs agree well enough to carry weight. The search scores
 //! every pose of a coarse-to-fine grid around the hypothesis on both maps' walls, as
