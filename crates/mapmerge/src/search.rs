@@ -75,7 +75,9 @@ impl Default for SearchConfig {
     }
 }
 
-/// Kernel values by distance in quarter pixels, zero beyond 4 sigma.
+/// Kernel values by distance in quarter pixels, zero beyond 4 sigma. Distances are read as
+/// bytes ([`PreparedMap::known_wall_quarters`], at most 254 quarters): a sigma above 15.8 px
+/// sees every wall farther than 63.5 px at 63.5 px.
 struct Kernel {
     table: Vec<f32>,
 }
@@ -95,7 +97,7 @@ impl Kernel {
     /// The kernel at a distance in quarter pixels ([`PreparedMap::known_wall_quarters`]);
     /// zero for an unknown cell.
     #[inline]
-    fn at(&self, quarters: u16) -> f32 {
+    fn at(&self, quarters: u8) -> f32 {
         if quarters == UNKNOWN_QUARTERS {
             return 0.0;
         }
