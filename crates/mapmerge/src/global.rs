@@ -197,15 +197,35 @@ fn fft2(
     let mut block = vec![Complex32::default(); BATCH * h];
     for x0 in (0..w).step_by(BATCH) {
         let k = BATCH.min(w - x0);
-        for y in 0..h {
-            for j in 0..k {
-                block[j * h + y] = data[y * w + x0 + j];
+        // A whole batch copies a fixed number of cells per row (a loop the compiler unrolls).
+        if k == BATCH {
+            for y in 0..h {
+                let row: &[Complex32; BATCH] = data[y * w + x0..][..BATCH].try_into().unwrap();
+                for (j, &z) in row.iter().enumerate() {
+                    block[j * h + y] = z;
+                }
+            }
+        } else {
+            for y in 0..h {
+                for j in 0..k {
+                    block[j * h + y] = data[y * w + x0 + j];
+                }
             }
         }
         col.process_with_scratch(&mut block[..k * h], &mut scratch);
-        for y in 0..h {
-            for j in 0..k {
-                data[y * w + x0 + j] = block[j * h + y];
+        if k == BATCH {
+            for y in 0..h {
+                let row: &mut [Complex32; BATCH] =
+                    (&mut data[y * w + x0..][..BATCH]).try_into().unwrap();
+                for (j, z) in row.iter_mut().enumerate() {
+                    *z = block[j * h + y];
+                }
+            }
+        } else {
+            for y in 0..h {
+                for j in 0..k {
+                    data[y * w + x0 + j] = block[j * h + y];
+                }
             }
         }
     }
@@ -320,6 +340,107 @@ impl CoarseField {
         planner: &mut FftPlanner<f32>,
         buf: &mut Vec<Complex32>,
     ) -> (Vec<Scored>, Vec<Scored>) {
+        let splat = self.correlation(pb, theta, planner, buf);
+        self.peaks(buf, theta, &splat, peaks)
+    }
+
+    /// The correlation images of [`Self::correlate`] into `buf` (`C(t)` in the real parts,
+    /// for a normalised field `N(t)` in the imaginary ones, both times `nw * nh`).
+    fn correlation(
+        &self,
+        pb: &[DVec2],
+        theta: f64,
+        planner: &mut FftPlanner<f32>,
+        buf: &mut Vec<Complex32>,
+    ) -> Splat {
+        let (nw, nh) = (self.nw, self.nh);
+        buf.clear();
+        buf.resize(nw * nh, Complex32::default());
+        let splat = self.splat(pb, theta, buf, false);
+        fft2(buf, (nw, nh), splat.rows, planner, false);
+        for (x, y) in buf.iter_mut().zip(&self.spectrum) {
+            *x = y * x.conj();
+        }
+        fft2(buf, (nw, nh), nh, planner, true);
+        splat
+    }
+
+    /// [`Self::correlate`] for two angles at once, with one forward transform for both: B's
+    /// two turned images are real, so one goes into the real part and the other into the
+    /// imaginary part, and their transforms are parted by symmetry
+    /// (`X1[k] = (Z[k] + conj Z[-k]) / 2`, `X2[k] = (Z[k] - conj Z[-k]) / 2i`). The same
+    /// correlations as two [`Self::correlate`]s up to the transforms' rounding. `bufs` are
+    /// scratch space.
+    fn correlate_pair(
+        &self,
+        pb: &[DVec2],
+        thetas: [f64; 2],
+        peaks: usize,
+        planner: &mut FftPlanner<f32>,
+        bufs: &mut (Vec<Complex32>, Vec<Complex32>),
+    ) -> [(Vec<Scored>, Vec<Scored>); 2] {
+        let splats = self.correlations(pb, thetas, planner, bufs);
+        [
+            self.peaks(&bufs.0, thetas[0], &splats[0], peaks),
+            self.peaks(&bufs.1, thetas[1], &splats[1], peaks),
+        ]
+    }
+
+    /// The correlation images of [`Self::correlate_pair`]: those of [`Self::correlation`] for
+    /// each angle, into each of `bufs`.
+    fn correlations(
+        &self,
+        pb: &[DVec2],
+        thetas: [f64; 2],
+        planner: &mut FftPlanner<f32>,
+        bufs: &mut (Vec<Complex32>, Vec<Complex32>),
+    ) -> [Splat; 2] {
+        let (nw, nh) = (self.nw, self.nh);
+        let (z, second) = bufs;
+        z.clear();
+        z.resize(nw * nh, Complex32::default());
+        second.clear();
+        second.resize(nw * nh, Complex32::default());
+        let splats = [
+            self.splat(pb, thetas[0], z, false),
+            self.splat(pb, thetas[1], z, true),
+        ];
+        fft2(
+            z,
+            (nw, nh),
+            splats[0].rows.max(splats[1].rows),
+            planner,
+            false,
+        );
+        // Part the transforms and multiply each by A's spectrum, a cell and its mirror
+        // `-k` together (the product overwrites both).
+        let half = Complex32::new(0.5, 0.0);
+        let minus_half_i = Complex32::new(0.0, -0.5);
+        for ky in 0..nh {
+            let my = if ky == 0 { 0 } else { nh - ky };
+            for kx in 0..nw {
+                let mx = if kx == 0 { 0 } else { nw - kx };
+                let (k, m) = (ky * nw + kx, my * nw + mx);
+                if m < k {
+                    continue;
+                }
+                let (zk, zm) = (z[k], z[m]);
+                let (x1k, x2k) = ((zk + zm.conj()) * half, (zk - zm.conj()) * minus_half_i);
+                let (x1m, x2m) = ((zm + zk.conj()) * half, (zm - zk.conj()) * minus_half_i);
+                let (sk, sm) = (self.spectrum[k], self.spectrum[m]);
+                (z[k], second[k]) = (sk * x1k.conj(), sk * x2k.conj());
+                (z[m], second[m]) = (sm * x1m.conj(), sm * x2m.conj());
+            }
+        }
+        fft2(z, (nw, nh), nh, planner, true);
+        fft2(second, (nw, nh), nh, planner, true);
+        splats
+    }
+
+    /// B's wall points `pb` turned by `theta`, as ones on the coarse grid (shifted so that the
+    /// lowest lands at 0) in the real part of `buf` (the imaginary part when `imaginary`),
+    /// which must be zero there.
+    fn splat(&self, pb: &[DVec2], theta: f64, buf: &mut [Complex32], imaginary: bool) -> Splat {
         let (nw, nh, scale) = (self.nw, self.nh, self.scale);
         let rot = DVec2::from_angle(theta);
         let q: Vec<DVec2> = pb.iter().map(|p| rot.rotate(*p)).collect();
@@ -327,23 +448,37 @@ impl CoarseField {
             .iter()
             .copied()
             .fold(DVec2::splat(f64::INFINITY), DVec2::min);
-        buf.clear();
-        buf.resize(nw * nh, Complex32::default());
         let (mut cells, mut rows) = (0usize, 0usize);
         for p in &q {
             let u = (*p - qmin) / scale;
-            let (ux, uy) = (u.x.round() as usize, u.y.round() as usize);
-            if ux < nw && uy < nh && buf[uy * nw + ux].re == 0.0 {
-                buf[uy * nw + ux].re = 1.0;
-                cells += 1;
-                rows = rows.max(uy + 1);
+            // `u` is not negative: `u + 0.5` truncated is `u` rounded (`f64::round` is a library
+            // call), but where `u + 0.5` rounds up to a whole number (`u` within 2^-53 below a
+            // half).
+            let (ux, uy) = ((u.x + 0.5) as usize, (u.y + 0.5) as usize);
+            if ux < nw && uy < nh {
+                let z = &mut buf[uy * nw + ux];
+                let part = if imaginary { &mut z.im } else { &mut z.re };
+                if *part == 0.0 {
+                    *part = 1.0;
+                    cells += 1;
+                    rows = rows.max(uy + 1);
+                }
             }
         }
-        fft2(buf, (nw, nh), rows, planner, false);
-        for (x, y) in buf.iter_mut().zip(&self.spectrum) {
-            *x = y * x.conj();
-        }
-        fft2(buf, (nw, nh), nh, planner, true);
+        Splat { qmin, cells, rows }
+    }
+
+    /// The peaks of [`Self::correlate`] from the inverse transform `buf` of the product of A's
+    /// spectrum and B's image (splatted as `splat`) turned by `theta`.
+    fn peaks(
+        &self,
+        buf: &[Complex32],
+        theta: f64,
+        splat: &Splat,
+        peaks: usize,
+    ) -> (Vec<Scored>, Vec<Scored>) {
+        let (nw, nh, scale) = (self.nw, self.nh, self.scale);
+        let (qmin, cells) = (splat.qmin, splat.cells);
         // B's image is real, so the real part is C(t) and, for a normalised field, the
         // imaginary part N(t): how many of B's wall cells land on known cells of A (both scaled
         // by the image size, the inverse FFT being unnormalised).
@@ -379,15 +514,22 @@ impl CoarseField {
             .iter()
             .map(|z| {
                 let (c, n) = (z.re / size, z.im / size);
-                if n >= min_cells {
-                    (c - mean * n) / (sd * n.sqrt())
-                } else {
-                    0.0
-                }
+                // Computed everywhere and then chosen, without a branch, so that the loop
+                // vectorises (a square root of a negative rounding error is chosen away).
+                let v = (c - mean * n) / (sd * n.sqrt());
+                if n >= min_cells { v } else { 0.0 }
             })
             .collect();
         (best(&plain), best(&normalized))
     }
+}
+
+/// Where [`CoarseField::splat`] put B's turned walls: the shift of its lowest point to the
+/// origin, the cells set and the rows they reach.
+struct Splat {
+    qmin: DVec2,
+    cells: usize,
+    rows: usize,
 }
 
 /// The best `peaks` positive local maxima `(value, x, y)` of the `w x h` image `score` (its
@@ -560,17 +702,19 @@ pub fn twins(
     );
     // The first turn is none: the other translation peaks of the placement's own angle are
     // its shifted twins (a row of alike rooms).
-    let found: Vec<Rigid2> = [0.0, 0.5, 1.0, 1.5]
+    // Two angles share a forward transform ([`CoarseField::correlate_pair`]).
+    let found: Vec<Rigid2> = [[0.0, 0.5], [1.0, 1.5]]
         .par_iter()
         .map_init(
-            || (FftPlanner::<f32>::new(), Vec::new()),
-            |(planner, buf), &k| {
-                let theta = b_to_a.theta + k * PI;
+            || (FftPlanner::<f32>::new(), (Vec::new(), Vec::new())),
+            |(planner, bufs), turns| {
+                let thetas = turns.map(|k| b_to_a.theta + k * PI);
                 field
-                    .correlate(&pb, theta, config.translation_peaks, planner, buf)
-                    .0
+                    .correlate_pair(&pb, thetas, config.translation_peaks, planner, bufs)
+                    .map(|(plain, _)| plain)
             },
         )
+        .flatten_iter()
         .flatten_iter()
         .map(|(_, t)| t)
         .collect();
@@ -742,15 +886,32 @@ pub fn sweep_placements(
         config.normalized,
         &mut FftPlanner::new(),
     );
-    let (plain, normalized): (Vec<_>, Vec<_>) = (0..steps)
+    // Two angles share a forward transform ([`CoarseField::correlate_pair`]).
+    let angle = |k: usize| (k as f64 * 2.0 * PI / steps as f64) - PI;
+    let (plain, normalized): (Vec<_>, Vec<_>) = (0..steps.div_ceil(2))
         .into_par_iter()
         .map_init(
-            || (FftPlanner::<f32>::new(), Vec::new()),
-            |(planner, buf), k| {
-                let theta = (k as f64 * 2.0 * PI / steps as f64) - PI;
-                field.correlate(&pb, theta, config.translation_peaks, planner, buf)
+            || (FftPlanner::<f32>::new(), (Vec::new(), Vec::new())),
+            |(planner, bufs), pair| {
+                let k = 2 * pair;
+                if k + 1 < steps {
+                    let peaks = config.translation_peaks;
+                    field
+                        .correlate_pair(&pb, [angle(k), angle(k + 1)], peaks, planner, bufs)
+                        .to_vec()
+                } else {
+                    let found = field.correlate(
+                        &pb,
+                        angle(k),
+                        config.translation_peaks,
+                        planner,
+                        &mut bufs.0,
+                    );
+                    vec![found]
+                }
             },
         )
+        .flatten_iter()
         .unzip();
     // The `keep` best distinct placements of one ranking over all angles.
     let best = |per_angle: Vec<Vec<Scored>>, keep: usize| {
@@ -890,6 +1051,37 @@ mod tests {
             // and it is the strongest correlation, not a lucky runner-up.
             let first = grid_core::metrics::displacement_error(&b, &found[0], &truth).unwrap();
             assert!(first < 6.0, "{deg} deg: first placement {first} px off");
+        }
+    }
+
+    #[test]
+    fn a_pair_of_angles_correlates_as_each_alone() {
+        let a = room();
+        let vc = VerifyConfig::default();
+        let b = a.warp(&Rigid2::new(0.7, 110.0, 30.0), 240, 220).unwrap();
+        let (pa, pb) = (PreparedMap::new(&a, &vc), PreparedMap::new(&b, &vc));
+        let points = strided(&pb.wall_samples, 4000);
+        let mut planner = FftPlanner::new();
+        let field = CoarseField::new(&pa, &pb, 96, 0.5, true, &mut planner);
+        let (mut bufs, mut alone) = ((Vec::new(), Vec::new()), Vec::new());
+        for thetas in [[-0.7, -0.66], [2.0, -3.1], [0.0, 0.0]] {
+            let splats = field.correlations(&points, thetas, &mut planner, &mut bufs);
+            for (k, paired) in [&bufs.0, &bufs.1].into_iter().enumerate() {
+                let splat = field.correlation(&points, thetas[k], &mut planner, &mut alone);
+                assert_eq!(
+                    (splats[k].qmin, splats[k].cells, splats[k].rows),
+                    (splat.qmin, splat.cells, splat.rows)
+                );
+                // Both images (C and N) the same up to the transforms' rounding.
+                let top = alone
+                    .iter()
+                    .map(|z| z.re.abs().max(z.im.abs()))
+                    .fold(0.0, f32::max);
+                assert!(top > 1e3, "{thetas:?}: an empty correlation");
+                for (p, q) in paired.iter().zip(&alone) {
+                    assert!((p - q).norm() <= 1e-5 * top, "{thetas:?}: {p} against {q}");
+                }
+            }
         }
     }
 

@@ -425,7 +425,11 @@ impl<'a> PreparedMap<'a> {
                 wall_classes.push(
                     CLASS_COMPARED
                         | if d <= classes_for.0 { CLASS_NEAR } else { 0 }
-                        | if d <= classes_for.1 { CLASS_NEAR_WIDE } else { 0 }
+                        | if d <= classes_for.1 {
+                            CLASS_NEAR_WIDE
+                        } else {
+                            0
+                        }
                         | if s == CellState::Free { CLASS_FREE } else { 0 },
                 );
                 // Truncated, as `(d * 4.0) as usize` would; saturating below the sentinel.
@@ -1141,7 +1145,10 @@ mod tests {
         let t = Rigid2::new(0.0, 1.0, 0.0);
         let (tight, loose) = (verify(&pa, &pb, &t, &other), verify(&pa, &pb, &t, &config));
         assert_eq!(tight, verify(&qa, &qb, &t, &other));
-        assert!(tight.wall_agreement < loose.wall_agreement - 0.3, "{tight:?} {loose:?}");
+        assert!(
+            tight.wall_agreement < loose.wall_agreement - 0.3,
+            "{tight:?} {loose:?}"
+        );
     }
 
     #[test]
