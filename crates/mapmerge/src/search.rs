@@ -79,18 +79,20 @@ impl Default for SearchConfig {
 /// bytes ([`PreparedMap::known_wall_quarters`], at most 254 quarters): a sigma above 15.8 px
 /// sees every wall farther than 63.5 px at 63.5 px.
 struct Kernel {
-    table: Vec<f32>,
+    /// One value per byte, so that a lookup needs no bounds check: 0 beyond 4 sigma and at
+    /// [`UNKNOWN_QUARTERS`].
+    table: [f32; 256],
 }
 
 impl Kernel {
     fn new(sigma: f64) -> Self {
         let n = (16.0 * sigma).ceil() as usize + 1;
-        let table = (0..n)
-            .map(|i| {
-                let d = i as f64 / 4.0;
-                (-d * d / (2.0 * sigma * sigma)).exp() as f32
-            })
-            .collect();
+        let mut table = [0.0; 256];
+        for (i, v) in table.iter_mut().enumerate().take(n) {
+            let d = i as f64 / 4.0;
+            *v = (-d * d / (2.0 * sigma * sigma)).exp() as f32;
+        }
+        table[UNKNOWN_QUARTERS as usize] = 0.0;
         Self { table }
     }
 
@@ -98,10 +100,7 @@ impl Kernel {
     /// zero for an unknown cell.
     #[inline]
     fn at(&self, quarters: u8) -> f32 {
-        if quarters == UNKNOWN_QUARTERS {
-            return 0.0;
-        }
-        self.table.get(quarters as usize).copied().unwrap_or(0.0)
+        self.table[quarters as usize]
     }
 }
 
@@ -129,6 +128,40 @@ fn shifted_scores(turned: &[DVec2], onto: &PreparedMap, shifts: &[DVec2], k: &Ke
     for &r in turned {
         for (s, &shift) in sums.iter_mut().zip(shifts) {
             *s += k.at(onto.known_wall_quarters(r + shift));
+        }
+    }
+    sums
+}
+
+/// [`shifted_score`] for each shift `base + step` of `steps` (whole cells), in order: a point
+/// lands on the cell of `r + base` moved by the step, so it is rounded once and then stepped
+/// through the cells. The same sums as [`shifted_scores`] over those shifts but where a point
+/// lies within rounding of a cell's edge.
+fn lattice_scores(
+    turned: &[DVec2],
+    onto: &PreparedMap,
+    base: DVec2,
+    steps: &[(i64, i64)],
+    k: &Kernel,
+) -> Vec<f32> {
+    let mut sums = vec![0.0f32; steps.len()];
+    let (x0, y0, w, h) = onto.walls.window();
+    for &r in turned {
+        let q = r + base;
+        let Some((cx, cy)) = crate::verify::nearest_cell(q) else {
+            // Off the map's low side at the base: look each shift up.
+            for (s, &(dx, dy)) in sums.iter_mut().zip(steps) {
+                let shift = DVec2::new(dx as f64, dy as f64);
+                *s += k.at(onto.known_wall_quarters(q + shift));
+            }
+            continue;
+        };
+        let (cx, cy) = (cx as i64 - x0 as i64, cy as i64 - y0 as i64);
+        for (s, &(dx, dy)) in sums.iter_mut().zip(steps) {
+            let (x, y) = (cx + dx, cy + dy);
+            if x >= 0 && y >= 0 && (x as usize) < w && (y as usize) < h {
+                *s += k.at(onto.known_quarters_at(y as usize * w + x as usize));
+            }
         }
     }
     sums
@@ -204,12 +237,23 @@ pub fn local_search(
                 turned(sa, at_angle.inverse().theta),
             );
             let poses: Vec<Rigid2> = offsets.iter().map(|&d| pose(dtheta, d)).collect();
-            let shifts_b: Vec<DVec2> = poses.iter().map(|t| t.translation()).collect();
             let shifts_a: Vec<DVec2> = poses.iter().map(|t| t.inverse().translation()).collect();
-            let (sums_b, sums_a) = (
-                shifted_scores(&tb, a, &shifts_b, &kernel),
-                shifted_scores(&ta, b, &shifts_a, &kernel),
-            );
+            // B's points move with the offset itself: on the levels of whole-pixel steps they
+            // step through whole cells.
+            let sums_b = if step.fract() == 0.0 && step.abs() < 1e6 {
+                let steps: Vec<(i64, i64)> = offsets
+                    .iter()
+                    .map(|&d| {
+                        let o = d - d0;
+                        (o.x as i64, o.y as i64)
+                    })
+                    .collect();
+                lattice_scores(&tb, a, at_angle.translation(), &steps, &kernel)
+            } else {
+                let shifts_b: Vec<DVec2> = poses.iter().map(|t| t.translation()).collect();
+                shifted_scores(&tb, a, &shifts_b, &kernel)
+            };
+            let sums_a = shifted_scores(&ta, b, &shifts_a, &kernel);
             for (k, &d) in offsets.iter().enumerate() {
                 let s = sums_b[k] + sums_a[k];
                 // Strictly better only: on a plateau the hypothesis (or the earlier pose)
@@ -273,6 +317,39 @@ mod tests {
             } else {
                 assert_eq!(found.theta, start.theta, "translation-only search turned");
             }
+        }
+    }
+
+    #[test]
+    fn whole_cell_shifts_score_as_each_shift_alone() {
+        let a = room();
+        let pa = PreparedMap::new(&a, &VerifyConfig::default());
+        let k = Kernel::new(3.5);
+        let points = turned(&strided(&pa.wall_samples, 300), 0.3);
+        // A lattice of whole cells around a fractional base, some of it off the map.
+        for (base, step) in [
+            (DVec2::new(17.3, -8.6), 2),
+            (DVec2::new(-60.25, 4.7), 1),
+            (DVec2::new(95.1, 40.2), 8),
+            (DVec2::new(-150.4, -20.2), 4),
+        ] {
+            let steps: Vec<(i64, i64)> = (-4..=4)
+                .flat_map(|j| (-4..=4).map(move |i| (i * step, j * step)))
+                .collect();
+            let each: Vec<f32> = steps
+                .iter()
+                .map(|&(dx, dy)| {
+                    let shift = base + DVec2::new(dx as f64, dy as f64);
+                    shifted_score(&points, &pa, shift, &k)
+                })
+                .collect();
+            assert_eq!(
+                lattice_scores(&points, &pa, base, &steps, &k),
+                each,
+                "{base}"
+            );
+            // Not a lattice of empty sums: walls are hit (but far off the map).
+            assert_eq!(each.iter().any(|&v| v > 10.0), base.x > -100.0, "{each:?}");
         }
     }
 

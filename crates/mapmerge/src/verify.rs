@@ -494,6 +494,12 @@ impl<'a> PreparedMap<'a> {
             .map_or(UNKNOWN_QUARTERS, |i| self.known_quarters[i])
     }
 
+    /// [`Self::known_wall_quarters`] of the cell at window index `i`.
+    #[inline]
+    pub(crate) fn known_quarters_at(&self, i: usize) -> u8 {
+        self.known_quarters[i]
+    }
+
     /// Window index ([`NearestOccupied::index`]) of the cell nearest to point `q`, if that cell
     /// lies in the known window.
     #[inline]
