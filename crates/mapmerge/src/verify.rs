@@ -251,8 +251,10 @@ const CLASS_COMPARED: u8 = 1;
 const CLASS_NEAR: u8 = 2;
 /// ... within the wide tolerance of one, ...
 const CLASS_NEAR_WIDE: u8 = 4;
-/// ... and it is free.
+/// ... it is free ...
 const CLASS_FREE: u8 = 8;
+/// ... or occupied (neither: unknown).
+const CLASS_OCCUPIED: u8 = 16;
 
 /// A map with what verification and refinement need precomputed once.
 #[derive(Debug)]
@@ -291,17 +293,15 @@ pub struct PreparedMap<'a> {
     /// where the local search's kernel (4 sigma, sigma at most 15.8 px) is long zero; half the
     /// bytes of a `u16`, so more of the window stays in cache.
     known_quarters: Vec<u8>,
-    /// Per cell of the known window, what [`verify`] asks of a wall cell landing there, as
-    /// bits ([`CLASS_COMPARED`] and the rest) for the tolerances in `classes_for`: one lookup
-    /// instead of the cell's state and its distance.
+    /// Per cell of the known window, what [`verify`] asks of a cell a sample lands on, as bits
+    /// ([`CLASS_COMPARED`] and the rest; the tolerance bits for the tolerances in
+    /// `classes_for`; whether walls are compared with the shadow the map was prepared with,
+    /// as the base rates): one lookup instead of the cell's state and its distance.
     wall_classes: Vec<u8>,
     /// The wall tolerance and the wide tolerance `wall_classes` were computed with.
     classes_for: (f32, f32),
     /// The state of each of `known_samples` (free or occupied), in order.
     known_sample_states: Vec<CellState>,
-    /// The shadow ([`VerifyConfig::shadow_px`], as used) `known_quarters` and the base rates
-    /// were computed with; the wall lift compares with the same.
-    shadow: f32,
 }
 
 /// How [`strided`] picks `max` of `len` items: how many it keeps, and the step such that pick
@@ -430,7 +430,11 @@ impl<'a> PreparedMap<'a> {
                         } else {
                             0
                         }
-                        | if s == CellState::Free { CLASS_FREE } else { 0 },
+                        | match s {
+                            CellState::Free => CLASS_FREE,
+                            CellState::Occupied => CLASS_OCCUPIED,
+                            CellState::Unknown => 0,
+                        },
                 );
                 // Truncated, as `(d * 4.0) as usize` would; saturating below the sentinel.
                 known_quarters.push(((d * 4.0) as u8).min(UNKNOWN_QUARTERS - 1));
@@ -472,7 +476,6 @@ impl<'a> PreparedMap<'a> {
             wall_classes,
             classes_for,
             known_sample_states,
-            shadow,
         };
         prepared.wall_sides = prepared
             .wall_samples
@@ -726,7 +729,7 @@ fn wall_hits(
     let (mut hits, mut wide_hits, mut contra, mut total) = (0, 0, 0, 0);
     if !corrected && onto.classes_for == (tol, wide) {
         // The same tests, read from the cells' classes: a cell outside the known window is
-        // unknown and beyond the shadow, so not compared, as below.
+        // unknown and beyond the shadow, so not compared.
         for &p in &from.wall_samples {
             let Some(i) = onto.window_index(t.apply(p)) else {
                 continue;
@@ -745,40 +748,43 @@ fn wall_hits(
         }
         return (hits, wide_hits, contra, total);
     }
+    // Whether walls are compared at a cell, and whether it is free, do not depend on the
+    // tolerances: read from the classes here too.
+    let distances = onto.walls.distances();
     for (&p, &side) in from.wall_samples.iter().zip(&from.wall_sides) {
         let m = if corrected {
             t.apply(p + off_from * side)
         } else {
             t.apply(p)
         };
-        if let Some((x, y)) = cell_of(onto.grid, m) {
-            let state = onto.grid.state(x, y);
-            let cell_d = onto.walls.distance(x, y);
-            if !compared(state, cell_d, onto.shadow) {
-                continue;
-            }
-            total += 1;
-            let d = if corrected {
-                // Distance to the nearest wall cell moved by its map's offset.
-                match onto.walls.nearest(x, y) {
-                    Some(((qx, qy), _)) => {
-                        let q =
-                            DVec2::new(qx as f64, qy as f64) + off_onto * onto.free_side(qx, qy);
-                        (m - q).length() as f32
-                    }
-                    None => f32::INFINITY,
+        let Some(i) = onto.window_index(m) else {
+            continue;
+        };
+        let c = onto.wall_classes[i];
+        if c & CLASS_COMPARED == 0 {
+            continue;
+        }
+        total += 1;
+        let d = if corrected {
+            // Distance to the nearest wall cell moved by its map's offset.
+            match onto.walls.nearest_at(i) {
+                Some((site, _)) => {
+                    let (qx, qy) = onto.walls.cell(site);
+                    let q = DVec2::new(qx as f64, qy as f64) + off_onto * onto.free_side(qx, qy);
+                    (m - q).length() as f32
                 }
-            } else {
-                cell_d
-            };
-            if d <= tol {
-                hits += 1;
+                None => f32::INFINITY,
             }
-            if d <= wide {
-                wide_hits += 1;
-            } else if state == CellState::Free {
-                contra += 1;
-            }
+        } else {
+            distances[i]
+        };
+        if d <= tol {
+            hits += 1;
+        }
+        if d <= wide {
+            wide_hits += 1;
+        } else if c & CLASS_FREE != 0 {
+            contra += 1;
         }
     }
     (hits, wide_hits, contra, total)
@@ -927,16 +933,22 @@ pub fn verify_with_offsets(
     );
 
     let (mut agree, mut both) = (0usize, 0usize);
+    // A's state read from its cell classes: a cell outside the known window is unknown.
     for (&p, &sb) in b.known_samples.iter().zip(&b.known_sample_states) {
-        if let Some((x, y)) = cell_of(a.grid, b_to_a.apply(p)) {
-            let sa = a.grid.state(x, y);
-            if sa == CellState::Unknown {
-                continue;
-            }
-            both += 1;
-            if sa == sb {
-                agree += 1;
-            }
+        let Some(i) = a.window_index(b_to_a.apply(p)) else {
+            continue;
+        };
+        let c = a.wall_classes[i];
+        let sa = if c & CLASS_FREE != 0 {
+            CellState::Free
+        } else if c & CLASS_OCCUPIED != 0 {
+            CellState::Occupied
+        } else {
+            continue;
+        };
+        both += 1;
+        if sa == sb {
+            agree += 1;
         }
     }
     let acceptance_index = if both == 0 {
@@ -1133,6 +1145,23 @@ mod tests {
         ] {
             let read = verify(&qa, &qb, &t, &config);
             assert_eq!(verify(&pa, &pb, &t, &config), read, "{t:?}");
+            // The acceptance index as the grids' states give it.
+            let (mut agree, mut both) = (0, 0);
+            for p in &pb.known_samples {
+                if let Some((x, y)) = cell_of(&a, t.apply(*p)) {
+                    let sa = a.state(x, y);
+                    if sa != CellState::Unknown {
+                        both += 1;
+                        agree += usize::from(sa == b.state(p.x as usize, p.y as usize));
+                    }
+                }
+            }
+            let index = if both == 0 {
+                0.0
+            } else {
+                agree as f64 / both as f64
+            };
+            assert_eq!(read.acceptance_index, index, "{t:?}");
             // Every pose but the last (off the maps) compares walls.
             assert!((read.wall_support > 0) == (t.tx < 200.0), "{t:?}: {read:?}");
         }
