@@ -76,6 +76,38 @@ pub fn fast_atan2(y: f32, x: f32) -> f32 {
     if y < 0.0 { -r } else { r }
 }
 
+/// `a.rem_euclid(TAU)` for `a` in `(-2 TAU, 2 TAU)`, with the same value: `f32::rem_euclid` is
+/// a library call (`fmodf`) on baseline x86-64, and the descriptor takes one per sample. Below
+/// zero, `a + TAU` is exact where `fmod` would subtract a turn (the two are within a factor of
+/// two), and the last addition rounds as `rem_euclid`'s does.
+#[inline]
+fn wrap_turn(a: f32) -> f32 {
+    let mut r = a;
+    if r >= TAU {
+        r -= TAU;
+    }
+    if r <= -TAU {
+        r += TAU;
+    }
+    if r < 0.0 { r + TAU } else { r }
+}
+
+/// `v.floor()` without the library call (`floorf` on baseline x86-64), for `|v| < 2^23`.
+#[inline]
+fn floor(v: f32) -> f32 {
+    let t = v as i32 as f32;
+    if t > v { t - 1.0 } else { t }
+}
+
+/// `v.round() as usize` for `0 <= v < 2^23`, without the library call: `v + 0.5` truncated, less
+/// one where that sum rounded up to a whole number (`v` just below a half).
+#[inline]
+fn round_to_usize(v: f32) -> usize {
+    let r = (v + 0.5) as usize;
+    // In f64 the difference is exact.
+    if r as f64 - v as f64 > 0.5 { r - 1 } else { r }
+}
+
 /// Central-difference gradient `(gx, gy)` at an interior pixel.
 #[inline]
 fn gradient(img: &Image, x: usize, y: usize) -> (f32, f32) {
@@ -175,8 +207,8 @@ fn orientation_histogram(
             if mag == 0.0 {
                 continue;
             }
-            let angle = fast_atan2(gy, gx).rem_euclid(TAU);
-            let bin = ((angle * scale).round() as usize) % ORIENTATION_BINS;
+            let angle = wrap_turn(fast_atan2(gy, gx));
+            let bin = round_to_usize(angle * scale) % ORIENTATION_BINS;
             hist[bin] += wxm * wy * mag;
         }
     }
@@ -235,9 +267,14 @@ fn descriptor(
             // Continuous bin coordinates: histogram centres sit at integers 0..N_HIST.
             let bu = u / bin_width + (N_HIST as f32 - 1.0) / 2.0;
             let bv = v / bin_width + (N_HIST as f32 - 1.0) / 2.0;
-            let bo =
-                ((fast_atan2(gy, gx) - theta).rem_euclid(TAU) * ori_scale).rem_euclid(N_ORI as f32);
-            let (iu, iv, io) = (bu.floor(), bv.floor(), bo.floor());
+            // In [0, N_ORI]: wrapping `N_ORI` to 0 is `rem_euclid(N_ORI)`.
+            let bo = wrap_turn(fast_atan2(gy, gx) - theta) * ori_scale;
+            let bo = if bo >= N_ORI as f32 {
+                bo - N_ORI as f32
+            } else {
+                bo
+            };
+            let (iu, iv, io) = (floor(bu), floor(bv), floor(bo));
             let (fu, fv, fo) = (bu - iu, bv - iv, bo - io);
             let (iu, iv, io) = (iu as isize, iv as isize, io as usize % N_ORI);
             for (du, wu) in [(0isize, 1.0 - fu), (1, fu)] {
@@ -276,6 +313,44 @@ fn descriptor(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_cheap_roundings_give_the_library_values() {
+        let mut state = 7u32;
+        let mut values = vec![
+            0.0f32,
+            -0.0,
+            0.5,
+            -0.5,
+            1.5,
+            2.5,
+            0.499_999_97,
+            -1.0,
+            TAU,
+            -TAU,
+        ];
+        for _ in 0..100_000 {
+            state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            values.push((state as f32 / u32::MAX as f32 - 0.5) * 4.0 * TAU);
+        }
+        for &v in &values {
+            if v.abs() < 2.0 * TAU {
+                // Equal values (a zero's sign may differ).
+                assert_eq!(wrap_turn(v), v.rem_euclid(TAU), "{v}");
+            }
+            assert_eq!(floor(v), v.floor(), "{v}");
+            if v >= 0.0 {
+                assert_eq!(round_to_usize(v), v.round() as usize, "{v}");
+            }
+        }
+        // Just below each half and at it.
+        for k in 0..40u32 {
+            let half = k as f32 + 0.5;
+            for v in [half, f32::from_bits(half.to_bits() - 1)] {
+                assert_eq!(round_to_usize(v), v.round() as usize, "{v}");
+            }
+        }
+    }
 
     #[test]
     fn fast_atan2_is_accurate_everywhere() {
