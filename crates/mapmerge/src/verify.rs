@@ -336,6 +336,9 @@ struct StridedPicker<T> {
     made: usize,
     max: usize,
     step: f64,
+    /// The item the next pick takes (`usize::MAX` once `max` are made): computed once per
+    /// pick rather than per item offered (millions of cells per map).
+    next: usize,
     picked: Vec<T>,
 }
 
@@ -347,6 +350,7 @@ impl<T: Copy> StridedPicker<T> {
             made: 0,
             max,
             step,
+            next: if max > 0 { 0 } else { usize::MAX },
             picked: Vec::with_capacity(max),
         }
     }
@@ -354,10 +358,15 @@ impl<T: Copy> StridedPicker<T> {
     /// Offer the next item; whether it was picked.
     #[inline]
     fn offer(&mut self, p: T) -> bool {
-        let pick = self.made < self.max && self.seen == (self.made as f64 * self.step) as usize;
+        let pick = self.seen == self.next;
         if pick {
             self.picked.push(p);
             self.made += 1;
+            self.next = if self.made < self.max {
+                (self.made as f64 * self.step) as usize
+            } else {
+                usize::MAX
+            };
         }
         self.seen += 1;
         pick
@@ -1002,6 +1011,26 @@ mod tests {
             .map(|k| (k as f64 * 1001.0 / 20.0) as usize)
             .collect();
         assert_eq!(picked, want);
+    }
+
+    #[test]
+    fn the_picker_keeps_what_strided_keeps() {
+        for (len, max) in [
+            (10, 4),
+            (10, 3),
+            (10, 10),
+            (10, 50),
+            (1001, 20),
+            (7, 0),
+            (0, 5),
+        ] {
+            let items: Vec<usize> = (0..len).collect();
+            let mut picker = StridedPicker::new(len, max);
+            let flags: Vec<bool> = items.iter().map(|&i| picker.offer(i)).collect();
+            let want = strided(&items, max);
+            assert_eq!(picker.picked, want, "{len} {max}");
+            assert_eq!(flags.iter().filter(|&&f| f).count(), want.len());
+        }
     }
 
     #[test]
