@@ -125,9 +125,20 @@ fn shifted_score(turned: &[DVec2], onto: &PreparedMap, shift: DVec2, k: &Kernel)
 /// shifts lie close together, so they stay in the nearest cache.
 fn shifted_scores(turned: &[DVec2], onto: &PreparedMap, shifts: &[DVec2], k: &Kernel) -> Vec<f32> {
     let mut sums = vec![0.0f32; shifts.len()];
+    // Each point moved once by the half cell of rounding and the window's origin, so that a
+    // shifted point's window cell is its coordinates truncated, where they lie in the window:
+    // the same cells as `known_wall_quarters` but where a point lies within rounding of a
+    // cell's edge.
+    let (x0, y0, w, h) = onto.walls.window();
+    let corner = DVec2::new(0.5 - x0 as f64, 0.5 - y0 as f64);
+    let (wf, hf) = (w as f64, h as f64);
     for &r in turned {
+        let r = r + corner;
         for (s, &shift) in sums.iter_mut().zip(shifts) {
-            *s += k.at(onto.known_wall_quarters(r + shift));
+            let q = r + shift;
+            if q.x >= 0.0 && q.y >= 0.0 && q.x < wf && q.y < hf {
+                *s += k.at(onto.known_quarters_at(q.y as usize * w + q.x as usize));
+            }
         }
     }
     sums
@@ -321,7 +332,7 @@ mod tests {
     }
 
     #[test]
-    fn whole_cell_shifts_score_as_each_shift_alone() {
+    fn shifts_scored_together_score_as_each_alone() {
         let a = room();
         let pa = PreparedMap::new(&a, &VerifyConfig::default());
         let k = Kernel::new(3.5);
@@ -348,6 +359,16 @@ mod tests {
                 each,
                 "{base}"
             );
+            // Shifts of any fraction, read from the window directly, give the same sums.
+            let shifts: Vec<DVec2> = steps
+                .iter()
+                .map(|&(dx, dy)| base + DVec2::new(dx as f64, dy as f64) * 0.37)
+                .collect();
+            let each: Vec<f32> = shifts
+                .iter()
+                .map(|&s| shifted_score(&points, &pa, s, &k))
+                .collect();
+            assert_eq!(shifted_scores(&points, &pa, &shifts, &k), each, "{base}");
             // Not a lattice of empty sums: walls are hit (but far off the map).
             assert_eq!(each.iter().any(|&v| v > 10.0), base.x > -100.0, "{each:?}");
         }
