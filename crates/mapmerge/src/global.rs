@@ -331,17 +331,18 @@ impl CoarseField {
     /// The best `peaks` translations for B's wall points `pb` turned by `theta`: local maxima
     /// of `C(t) = sum_u F_A(u + t) P_B(u)`, as B→A transforms with their correlation, best
     /// first; and, for a normalised field, the best `peaks` of the normalised correlation
-    /// (empty otherwise), from the same transforms. `buf` is scratch space of `nw * nh`.
+    /// (empty otherwise), from the same transforms.
     fn correlate(
         &self,
         pb: &[DVec2],
         theta: f64,
         peaks: usize,
         planner: &mut FftPlanner<f32>,
-        buf: &mut Vec<Complex32>,
+        bufs: &mut Buffers,
     ) -> (Vec<Scored>, Vec<Scored>) {
-        let splat = self.correlation(pb, theta, planner, buf);
-        self.peaks(buf, theta, &splat, peaks)
+        let splat = self.correlation(pb, theta, planner, &mut bufs.z);
+        let scores = (&mut bufs.plain, &mut bufs.normalized);
+        self.peaks(&bufs.z, theta, &splat, peaks, scores)
     }
 
     /// The correlation images of [`Self::correlate`] into `buf` (`C(t)` in the real parts,
@@ -369,21 +370,26 @@ impl CoarseField {
     /// two turned images are real, so one goes into the real part and the other into the
     /// imaginary part, and their transforms are parted by symmetry
     /// (`X1[k] = (Z[k] + conj Z[-k]) / 2`, `X2[k] = (Z[k] - conj Z[-k]) / 2i`). The same
-    /// correlations as two [`Self::correlate`]s up to the transforms' rounding. `bufs` are
-    /// scratch space.
+    /// correlations as two [`Self::correlate`]s up to the transforms' rounding.
     fn correlate_pair(
         &self,
         pb: &[DVec2],
         thetas: [f64; 2],
         peaks: usize,
         planner: &mut FftPlanner<f32>,
-        bufs: &mut (Vec<Complex32>, Vec<Complex32>),
+        bufs: &mut Buffers,
     ) -> [(Vec<Scored>, Vec<Scored>); 2] {
-        let splats = self.correlations(pb, thetas, planner, bufs);
-        [
-            self.peaks(&bufs.0, thetas[0], &splats[0], peaks),
-            self.peaks(&bufs.1, thetas[1], &splats[1], peaks),
-        ]
+        let splats = self.correlations(pb, thetas, planner, (&mut bufs.z, &mut bufs.second));
+        let (plain, normalized) = (&mut bufs.plain, &mut bufs.normalized);
+        let first = self.peaks(&bufs.z, thetas[0], &splats[0], peaks, (plain, normalized));
+        let second = self.peaks(
+            &bufs.second,
+            thetas[1],
+            &splats[1],
+            peaks,
+            (plain, normalized),
+        );
+        [first, second]
     }
 
     /// The correlation images of [`Self::correlate_pair`]: those of [`Self::correlation`] for
@@ -393,10 +399,9 @@ impl CoarseField {
         pb: &[DVec2],
         thetas: [f64; 2],
         planner: &mut FftPlanner<f32>,
-        bufs: &mut (Vec<Complex32>, Vec<Complex32>),
+        (z, second): (&mut Vec<Complex32>, &mut Vec<Complex32>),
     ) -> [Splat; 2] {
         let (nw, nh) = (self.nw, self.nh);
-        let (z, second) = bufs;
         z.clear();
         z.resize(nw * nh, Complex32::default());
         second.clear();
@@ -469,13 +474,15 @@ impl CoarseField {
     }
 
     /// The peaks of [`Self::correlate`] from the inverse transform `buf` of the product of A's
-    /// spectrum and B's image (splatted as `splat`) turned by `theta`.
+    /// spectrum and B's image (splatted as `splat`) turned by `theta`; `scores` is scratch
+    /// space for the plain and the normalised score images.
     fn peaks(
         &self,
         buf: &[Complex32],
         theta: f64,
         splat: &Splat,
         peaks: usize,
+        (plain, normalized): (&mut Vec<f32>, &mut Vec<f32>),
     ) -> (Vec<Scored>, Vec<Scored>) {
         let (nw, nh, scale) = (self.nw, self.nh, self.scale);
         let (qmin, cells) = (splat.qmin, splat.cells);
@@ -500,9 +507,10 @@ impl CoarseField {
                 .map(|(v, tx, ty)| (v, placement(tx, ty)))
                 .collect::<Vec<_>>()
         };
-        let plain: Vec<f32> = buf.iter().map(|z| z.re).collect();
+        plain.clear();
+        plain.extend(buf.iter().map(|z| z.re));
         let Some((mean, sd)) = self.normalization else {
-            return (best(&plain), Vec::new());
+            return (best(plain), Vec::new());
         };
         // A random placement scores about `mean * N` with a spread of `sd * sqrt(N)`; the
         // normalised ranking is by how far above that a placement is, so that a larger overlap
@@ -510,18 +518,27 @@ impl CoarseField {
         // on known cells of A are not considered.
         let size = (nw * nh) as f32;
         let min_cells = (0.1 * cells as f32).max(5.0);
-        let normalized: Vec<f32> = buf
-            .iter()
-            .map(|z| {
-                let (c, n) = (z.re / size, z.im / size);
-                // Computed everywhere and then chosen, without a branch, so that the loop
-                // vectorises (a square root of a negative rounding error is chosen away).
-                let v = (c - mean * n) / (sd * n.sqrt());
-                if n >= min_cells { v } else { 0.0 }
-            })
-            .collect();
-        (best(&plain), best(&normalized))
+        normalized.clear();
+        normalized.extend(buf.iter().map(|z| {
+            let (c, n) = (z.re / size, z.im / size);
+            // Computed everywhere and then chosen, without a branch, so that the loop
+            // vectorises (a square root of a negative rounding error is chosen away).
+            let v = (c - mean * n) / (sd * n.sqrt());
+            if n >= min_cells { v } else { 0.0 }
+        }));
+        (best(plain), best(normalized))
     }
+}
+
+/// Scratch space of the correlations, one per thread: the transforms' images and the score
+/// images their peaks are read from, allocated once rather than per angle (each a fresh
+/// mapping of a few hundred kilobytes, whose pages the kernel faults in and zeroes).
+#[derive(Default)]
+struct Buffers {
+    z: Vec<Complex32>,
+    second: Vec<Complex32>,
+    plain: Vec<f32>,
+    normalized: Vec<f32>,
 }
 
 /// Where [`CoarseField::splat`] put B's turned walls: the shift of its lowest point to the
@@ -663,10 +680,10 @@ pub fn global_hypotheses(
     let found: Vec<Vec<Rigid2>> = angles
         .par_iter()
         .map_init(
-            || (FftPlanner::<f32>::new(), Vec::new()),
-            |(planner, buf), &theta| {
+            || (FftPlanner::<f32>::new(), Buffers::default()),
+            |(planner, bufs), &theta| {
                 let (found, _) =
-                    field.correlate(&pb, theta, config.translation_peaks, planner, buf);
+                    field.correlate(&pb, theta, config.translation_peaks, planner, bufs);
                 found.into_iter().map(|(_, t)| t).collect()
             },
         )
@@ -706,7 +723,7 @@ pub fn twins(
     let found: Vec<Rigid2> = [[0.0, 0.5], [1.0, 1.5]]
         .par_iter()
         .map_init(
-            || (FftPlanner::<f32>::new(), (Vec::new(), Vec::new())),
+            || (FftPlanner::<f32>::new(), Buffers::default()),
             |(planner, bufs), turns| {
                 let thetas = turns.map(|k| b_to_a.theta + k * PI);
                 field
@@ -891,7 +908,7 @@ pub fn sweep_placements(
     let (plain, normalized): (Vec<_>, Vec<_>) = (0..steps.div_ceil(2))
         .into_par_iter()
         .map_init(
-            || (FftPlanner::<f32>::new(), (Vec::new(), Vec::new())),
+            || (FftPlanner::<f32>::new(), Buffers::default()),
             |(planner, bufs), pair| {
                 let k = 2 * pair;
                 if k + 1 < steps {
@@ -900,13 +917,8 @@ pub fn sweep_placements(
                         .correlate_pair(&pb, [angle(k), angle(k + 1)], peaks, planner, bufs)
                         .to_vec()
                 } else {
-                    let found = field.correlate(
-                        &pb,
-                        angle(k),
-                        config.translation_peaks,
-                        planner,
-                        &mut bufs.0,
-                    );
+                    let found =
+                        field.correlate(&pb, angle(k), config.translation_peaks, planner, bufs);
                     vec![found]
                 }
             },
@@ -1063,10 +1075,10 @@ mod tests {
         let points = strided(&pb.wall_samples, 4000);
         let mut planner = FftPlanner::new();
         let field = CoarseField::new(&pa, &pb, 96, 0.5, true, &mut planner);
-        let (mut bufs, mut alone) = ((Vec::new(), Vec::new()), Vec::new());
+        let (mut z, mut second, mut alone) = (Vec::new(), Vec::new(), Vec::new());
         for thetas in [[-0.7, -0.66], [2.0, -3.1], [0.0, 0.0]] {
-            let splats = field.correlations(&points, thetas, &mut planner, &mut bufs);
-            for (k, paired) in [&bufs.0, &bufs.1].into_iter().enumerate() {
+            let splats = field.correlations(&points, thetas, &mut planner, (&mut z, &mut second));
+            for (k, paired) in [&z, &second].into_iter().enumerate() {
                 let splat = field.correlation(&points, thetas[k], &mut planner, &mut alone);
                 assert_eq!(
                     (splats[k].qmin, splats[k].cells, splats[k].rows),
