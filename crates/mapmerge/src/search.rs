@@ -256,7 +256,7 @@ pub fn local_search(
                     .iter()
                     .map(|&d| {
                         let o = d - d0;
-                        (o.x as i64, o.y as i64)
+                        (o.x.round() as i64, o.y.round() as i64)
                     })
                     .collect();
                 lattice_scores(&tb, a, at_angle.translation(), &steps, &kernel)
@@ -369,7 +369,7 @@ mod tests {
                 .map(|&s| shifted_score(&points, &pa, s, &k))
                 .collect();
             assert_eq!(shifted_scores(&points, &pa, &shifts, &k), each, "{base}");
-            // Not a lattice of empty sums: walls are hit (but far off the map).
+            // Walls are hit, but for the lattice far off the map.
             assert_eq!(each.iter().any(|&v| v > 10.0), base.x > -100.0, "{each:?}");
         }
     }

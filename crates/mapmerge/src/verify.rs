@@ -267,7 +267,9 @@ pub struct PreparedMap<'a> {
     pub wall_samples: Vec<DVec2>,
     /// The free side ([`PreparedMap::free_side`]) of each of `wall_samples`, in order.
     pub wall_sides: Vec<DVec2>,
-    /// Sampled known cells (pixel centres).
+    /// Sampled known cells (pixel centres). Their states are kept alongside, in order, as
+    /// `wall_sides` are with `wall_samples`: a changed list of samples is judged by the states
+    /// of those first taken.
     pub known_samples: Vec<DVec2>,
     /// Number of known (free or occupied) cells.
     pub known_cells: usize,
