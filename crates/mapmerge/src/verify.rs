@@ -1159,7 +1159,9 @@ mod tests {
             ..VerifyConfig::default()
         };
         let (pa, pb) = (PreparedMap::new(&a, &config), PreparedMap::new(&b, &config));
-        // The same maps with classes for no tolerance: verification reads the cells.
+        // The same maps with classes for no tolerance: verification reads each cell's
+        // distance to compare with the tolerances (whether walls are compared there, and
+        // whether it is free, still come from the classes).
         fn unclassed<'m>(m: &'m OccupancyGrid, config: &VerifyConfig) -> PreparedMap<'m> {
             PreparedMap {
                 classes_for: (f32::NAN, f32::NAN),
@@ -1203,7 +1205,7 @@ mod tests {
             .map(|p| b.state(p.x as usize, p.y as usize))
             .collect();
         assert_eq!(pb.known_sample_states, states);
-        // Another tolerance than the classes': the cells are read.
+        // Another tolerance than the classes': the cells' distances are read.
         let other = VerifyConfig {
             wall_tolerance_px: 0.5,
             ..config
