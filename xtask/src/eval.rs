@@ -104,6 +104,11 @@ pub struct EvalArgs {
     /// `mapmerge::global::SweepConfig::translation_peaks`), for calibration experiments.
     #[arg(long)]
     sweep_peaks: Option<usize>,
+    /// Override how far apart, in coarse cells, the rotation sweep's translations of one angle
+    /// are at least (`mapmerge::global::SweepConfig::peak_radius`; `1` was the rule before;
+    /// default: the library's), for calibration experiments.
+    #[arg(long)]
+    sweep_peak_radius: Option<usize>,
     /// Override how many placements of the rotation sweep's normalised ranking are screened by
     /// the local search before the best are refined (`mapmerge::global::SweepConfig::screened`;
     /// `0` screens none; default: the library's), for calibration experiments.
@@ -577,6 +582,9 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
         }
         if let Some(p) = args.sweep_peaks {
             sweep.translation_peaks = p;
+        }
+        if let Some(r) = args.sweep_peak_radius {
+            sweep.peak_radius = r;
         }
         if let Some(n) = args.sweep_screen {
             sweep.screened = n;
