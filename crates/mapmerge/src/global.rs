@@ -603,8 +603,8 @@ fn local_maxima(
                 if !enters(v, &found) {
                     continue;
                 }
-                // The eight neighbours first: most cells fail there, and a wider window
-                // holds them.
+                // The eight neighbours first: most cells fail there, and a cell that is not
+                // the largest of those is not the largest of a wider window either.
                 let is_max = if inner_row && tx > 0 && tx + 1 < w {
                     // Away from the borders the neighbours need no wrapping.
                     let i = ty * w + tx;
