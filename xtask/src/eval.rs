@@ -138,6 +138,10 @@ pub struct EvalArgs {
     /// Skip the polish of a clean best answer (to measure what it adds).
     #[arg(long)]
     no_polish: bool,
+    /// Skip the last climb of the answer's verification score (to measure what
+    /// `mapmerge::ascent` adds).
+    #[arg(long)]
+    no_ascent: bool,
     /// Keep the best answer's angle from ICP instead of the walls' Hough spectra (to measure
     /// what `mapmerge::SpectrumRotation` adds).
     #[arg(long)]
@@ -607,6 +611,9 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
     }
     if args.no_polish {
         config.pair.polish = None;
+    }
+    if args.no_ascent {
+        config.pair.ascent = None;
     }
     if let Some(px) = args.search_sigma {
         for search in [&mut config.pair.search, &mut config.pair.turn_search]

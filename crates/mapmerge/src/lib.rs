@@ -5,6 +5,7 @@
 //! into one call per pair, [`register_with`]. It is not for: file formats (see
 //! `grid_core::io`) or the command line (the `mapmerge` binary in this package).
 
+pub mod ascent;
 pub mod distance;
 pub mod global;
 pub mod refine;
