@@ -19,7 +19,9 @@
 //! (`sweep_placements`), the symmetry probes' correlations of one placement (`twins`), one
 //! correlative local search over +-2 degrees (the turn search each whole-map placement gets),
 //! one refinement and scoring of a placement (`refine_and_score`: ICP with the range-bias
-//! offsets, then verification) and one verification alone. The end-to-end time is about one
+//! offsets, then verification), one verification alone, the score ascent of an answer
+//! (`mapmerge::ascent`, which the hard pair's thin walls do not take) and its gate, the
+//! thickness of both maps' walls. The end-to-end time is about one
 //! sweep and the probes' correlations plus a few dozen placements each searched, refined and
 //! scored (see `timings_ms` of `mapmerge estimate --json`).
 //!
@@ -28,6 +30,7 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use grid_core::io::{LoadOptions, load_map};
 use grid_core::{CorrespondenceSource, OccupancyGrid, Rigid2, UNKNOWN};
+use mapmerge::ascent::{ascend, wall_thickness};
 use mapmerge::global::{sweep_placements, twins};
 use mapmerge::search::local_search;
 use mapmerge::verify::{PreparedMap, VerifyConfig, verify};
@@ -186,6 +189,17 @@ fn bench(c: &mut Criterion) {
     });
     g.bench_function("verify_one_placement", |bn| {
         bn.iter(|| verify(&ppa, &ppb, &start, &pair_config.verify))
+    });
+    // The score ascent and its gate. The hard pair's walls are thin (0.87 and 0.57, below
+    // `AscentConfig::min_wall_thickness`), so `register` does not climb its answer; here the
+    // ascent runs from the sweep's first placement refined, as it would on thicker walls.
+    let ascent = pair_config.ascent.expect("the default climbs the answer");
+    let refined = refine_and_score(&ppa, &ppb, &start, &pair_config.global_refine, pair_config).0;
+    g.bench_function("score_ascent_one_answer", |bn| {
+        bn.iter(|| ascend(&ppa, &ppb, &refined, &ascent, &pair_config.verify))
+    });
+    g.bench_function("wall_thickness_both_maps", |bn| {
+        bn.iter(|| (wall_thickness(&fa), wall_thickness(&fb)))
     });
     g.finish();
 }
