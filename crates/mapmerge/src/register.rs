@@ -384,6 +384,9 @@ pub struct Timings {
     pub sweep_ms: f64,
     /// Symmetry probes of the best accepted candidate, when they ran.
     pub symmetry_ms: f64,
+    /// The score ascent of the answer ([`PairConfig::ascent`]) with its gate (both maps'
+    /// wall thickness), when they ran.
+    pub ascent_ms: f64,
 }
 
 /// The answer for one pair.
@@ -1016,15 +1019,16 @@ fn register_as_given(
                     .polish
                     .is_none_or(|p| c.verification.wall_lift < p.min_wall_lift)
         })
-        && {
-            let (ta, tb) = rayon::join(|| wall_thickness(pa.grid), || wall_thickness(pb.grid));
-            ta.min(tb) >= ascent.min_wall_thickness
-        }
     {
-        let (t, v) = ascend(&pa, &pb, &best.transform, ascent, &config.verify);
-        if t != best.transform && v.accepted(&config.verify) {
-            (best.transform, best.verification) = (t, v);
+        let t0 = Instant::now();
+        let (ta, tb) = rayon::join(|| wall_thickness(pa.grid), || wall_thickness(pb.grid));
+        if ta.min(tb) >= ascent.min_wall_thickness {
+            let (t, v) = ascend(&pa, &pb, &best.transform, ascent, &config.verify);
+            if t != best.transform && v.accepted(&config.verify) {
+                (best.transform, best.verification) = (t, v);
+            }
         }
+        timings.ascent_ms = ms(t0);
     }
     // Ambiguity: another accepted, clearly different placement that scores almost as well.
     // "Different" is measured where it matters: how far apart the two put B's walls (`apart`).

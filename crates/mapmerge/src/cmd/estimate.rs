@@ -239,6 +239,7 @@ fn human(w: &mut impl Write, o: &serde_json::Value) -> std::io::Result<()> {
         "global_ms",
         "sweep_ms",
         "symmetry_ms",
+        "ascent_ms",
     ]
     .iter()
     .map(|k| t[*k].as_f64().unwrap_or(0.0))
