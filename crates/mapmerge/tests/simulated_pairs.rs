@@ -1,6 +1,6 @@
 //! Registration of simulated pairs with known truth: the whole-map searches (the rotation
 //! sweep's placements, `PairConfig::turn_search`) and the ambiguity test's basin rule
-//! (`VerifyConfig::basin_ratio`), the stand-out rule of acceptance (`VerifyConfig::stand_out`)
+//! (`VerifyConfig::basin_ratio`), the stand-out rule of acceptance (`VerifyConfig::stand_out`),
 //! the spectrum angle's lever (`SpectrumRotation::max_lever_px`) and the score ascent
 //! (`PairConfig::ascent`), and that the answer does not depend on the maps' unknown border
 //! (`PairConfig::frame_margin`).
