@@ -39,6 +39,12 @@ impl Rigid2 {
         Self { theta, tx, ty }
     }
 
+    /// The rotation by `theta` about the point `pivot` (which it leaves in place).
+    pub fn rotation_about(theta: f64, pivot: DVec2) -> Self {
+        let m = pivot - Self::new(theta, 0.0, 0.0).apply(pivot);
+        Self::new(theta, m.x, m.y)
+    }
+
     /// The translation as a vector.
     pub fn translation(&self) -> DVec2 {
         DVec2::new(self.tx, self.ty)
@@ -137,6 +143,20 @@ mod tests {
 
     fn rigid() -> impl Strategy<Value = Rigid2> {
         (-PI..PI, -1e3..1e3, -1e3..1e3).prop_map(|(t, x, y)| Rigid2::new(t, x, y))
+    }
+
+    #[test]
+    fn a_rotation_about_a_pivot_keeps_it_and_turns_the_rest() {
+        let pivot = DVec2::new(3.0, -2.0);
+        let t = Rigid2::rotation_about(PI / 2.0, pivot);
+        assert!((t.apply(pivot) - pivot).length() < 1e-12, "{t:?}");
+        // A point one to the right of the pivot ends one below it (y down: clockwise on screen).
+        let p = t.apply(pivot + DVec2::X);
+        assert!((p - (pivot + DVec2::Y)).length() < 1e-12, "{p}");
+        assert_eq!(
+            Rigid2::rotation_about(0.3, DVec2::ZERO),
+            Rigid2::new(0.3, 0.0, 0.0)
+        );
     }
 
     #[test]

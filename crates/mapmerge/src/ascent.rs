@@ -15,7 +15,7 @@
 //! ([`crate::refine::RefineConfig::range_bias`]) do better. [`wall_thickness`] tells the two
 //! apart ([`AscentConfig::min_wall_thickness`]).
 
-use grid_core::{CellState, DVec2, OccupancyGrid, Rigid2};
+use grid_core::{CellState, OccupancyGrid, Rigid2};
 use rayon::prelude::*;
 
 use crate::verify::{PreparedMap, Verification, VerifyConfig, verify};
@@ -81,12 +81,6 @@ pub fn wall_thickness(grid: &OccupancyGrid) -> f64 {
     }
 }
 
-/// The rotation by `theta` about `c`.
-fn turn_about(theta: f64, c: DVec2) -> Rigid2 {
-    let m = c - Rigid2::new(theta, 0.0, 0.0).apply(c);
-    Rigid2::new(theta, m.x, m.y)
-}
-
 /// Climb the verification score from `start` (B onto A). Returns the pose reached and its
 /// verification (that of `start` when no step improved it).
 pub fn ascend(
@@ -96,11 +90,7 @@ pub fn ascend(
     config: &AscentConfig,
     verify_config: &VerifyConfig,
 ) -> (Rigid2, Verification) {
-    let centre = if b.wall_samples.is_empty() {
-        DVec2::ZERO
-    } else {
-        b.wall_samples.iter().copied().sum::<DVec2>() / b.wall_samples.len() as f64
-    };
+    let centre = b.wall_centre();
     let mut pose = *start;
     let mut best = verify(a, b, &pose, verify_config);
     let mut step = config.initial_step_px;
@@ -113,8 +103,8 @@ pub fn ascend(
             Rigid2::new(pose.theta, pose.tx - step, pose.ty),
             Rigid2::new(pose.theta, pose.tx, pose.ty + step),
             Rigid2::new(pose.theta, pose.tx, pose.ty - step),
-            turn_about(turn, c).compose(&pose).normalized(),
-            turn_about(-turn, c).compose(&pose).normalized(),
+            Rigid2::rotation_about(turn, c).compose(&pose).normalized(),
+            Rigid2::rotation_about(-turn, c).compose(&pose).normalized(),
         ];
         let scored: Vec<Verification> = tries
             .par_iter()

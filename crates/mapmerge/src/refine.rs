@@ -422,7 +422,7 @@ pub fn refine_with_bias(
         }
     }
     // Guard against a refinement that slid along a corridor to somewhere else.
-    let centre = b.wall_samples.iter().copied().sum::<DVec2>() / b.wall_samples.len().max(1) as f64;
+    let centre = b.wall_centre();
     if !(t.theta.is_finite() && t.tx.is_finite() && t.ty.is_finite())
         || (t.apply(centre) - b_to_a.apply(centre)).length() > config.max_shift_px
     {

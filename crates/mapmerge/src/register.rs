@@ -220,10 +220,7 @@ fn turned_about_overlap(
     if n == 0 {
         return None;
     }
-    let pivot = sum / n as f64;
-    let d = theta - b_to_a.theta;
-    let moved = Rigid2::new(d, 0.0, 0.0).apply(pivot);
-    Some(Rigid2::new(d, pivot.x - moved.x, pivot.y - moved.y).compose(b_to_a))
+    Some(Rigid2::rotation_about(theta - b_to_a.theta, sum / n as f64).compose(b_to_a))
 }
 
 /// The polish of a clean answer: when the best candidate's walls agree almost everywhere,

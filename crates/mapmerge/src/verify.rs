@@ -558,6 +558,15 @@ impl<'a> PreparedMap<'a> {
         normal_and_side(self.normals[i], self.free_sides[i])
     }
 
+    /// The centre (mean) of [`Self::wall_samples`]; the origin when there are none.
+    pub fn wall_centre(&self) -> DVec2 {
+        if self.wall_samples.is_empty() {
+            DVec2::ZERO
+        } else {
+            self.wall_samples.iter().copied().sum::<DVec2>() / self.wall_samples.len() as f64
+        }
+    }
+
     /// Unit normal of the wall at occupied cell `(x, y)` pointing to its free side: zero when
     /// the wall has no clear direction, or free space on both sides or on neither (within
     /// [`FREE_SIDE_REACH`] cells).
