@@ -34,11 +34,12 @@ pub struct AscentConfig {
     pub max_moves: usize,
     /// The ascent runs only when both maps' walls are at least this thick
     /// ([`wall_thickness`]). Default 1.1. The default mapper of `mapsim` marks walls one cell
-    /// thick, often with unknown cells behind (0.77-0.82 on cases of seed 7), and a noisy
+    /// thick, often with unknown cells behind (0.66-0.85 on the 80 maps of the 30 % rows of
+    /// seed 7, `mapmerge info` on the maps `cargo xtask eval --export` writes), and a noisy
     /// range sensor pushes them behind the obstacle faces by amounts that differ from map to
     /// map: the score there peaks 3-5 px from the truth, and climbing it registered 3 more and
     /// 18 fewer of the 120 pairs at 30 % overlap (seeds 7-9). Hector's model marks walls about
-    /// two cells thick and in place (1.43-1.60); the floors of `fixtures/maps` measure
+    /// two cells thick and in place (1.25-1.76); the floors of `fixtures/maps` measure
     /// 0.65-2.34 as drawn (docs/EVALUATION.md, "The score ascent").
     pub min_wall_thickness: f64,
 }

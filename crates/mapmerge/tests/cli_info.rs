@@ -41,6 +41,12 @@ fn info_json(args: &[&str]) -> Value {
     serde_json::from_str(&text).unwrap()
 }
 
+/// The wall thickness of the map `yaml`, as `mapmerge::ascent::wall_thickness` measures it.
+fn thickness(yaml: &std::path::Path) -> f64 {
+    let map = grid_core::io::load_map(yaml, &grid_core::io::LoadOptions::default()).unwrap();
+    mapmerge::ascent::wall_thickness(&map)
+}
+
 /// (name, image extension, width, height, resolution, origin, free, occupied, unknown)
 type Row = (
     &'static str,
@@ -174,6 +180,19 @@ fn info_json_on_every_fixture() {
             "occupied": occupied,
             "unknown": unknown,
         });
+        // The library's measure (unit-tested on walls of known thickness), reported as is
+        // (to the last bit but one: serde_json's parser may round the last).
+        let mut got = got;
+        let reported = got
+            .as_object_mut()
+            .unwrap()
+            .remove("wall_thickness")
+            .and_then(|v| v.as_f64());
+        let want_thickness = thickness(&yaml);
+        assert!(
+            reported.is_some_and(|t| (t - want_thickness).abs() <= 1e-12 * want_thickness),
+            "{name}: {reported:?} against {want_thickness}"
+        );
         assert_eq!(got, want, "{name}");
     }
 }
@@ -192,10 +211,12 @@ fn info_human_form() {
          origin:     x 0 m, y 0 m, yaw 0 rad\n\
          free:       34520 (57.5%)\n\
          occupied:   3711 (6.2%)\n\
-         unknown:    21769 (36.3%)\n",
+         unknown:    21769 (36.3%)\n\
+         walls:      1.13 cells thick (occupied cells per side facing free space)\n",
         yaml.display(),
         fixture("wpi_ilab", "pgm").display()
     );
+    assert_eq!(format!("{:.2}", thickness(&yaml)), "1.13");
     assert_eq!(text, want);
 }
 
