@@ -142,6 +142,9 @@ pub struct EvalArgs {
     /// `mapmerge::ascent` adds).
     #[arg(long)]
     no_ascent: bool,
+    /// The wall thickness both maps need for the ascent (`AscentConfig::min_wall_thickness`).
+    #[arg(long, value_name = "CELLS")]
+    ascent_min_thickness: Option<f64>,
     /// Keep the best answer's angle from ICP instead of the walls' Hough spectra (to measure
     /// what `mapmerge::SpectrumRotation` adds).
     #[arg(long)]
@@ -614,6 +617,9 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
     }
     if args.no_ascent {
         config.pair.ascent = None;
+    }
+    if let (Some(t), Some(ascent)) = (args.ascent_min_thickness, config.pair.ascent.as_mut()) {
+        ascent.min_wall_thickness = t;
     }
     if let Some(px) = args.search_sigma {
         for search in [&mut config.pair.search, &mut config.pair.turn_search]
