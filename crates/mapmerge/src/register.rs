@@ -952,12 +952,17 @@ fn register_as_given(
         candidates[0].stands_out = false;
         rank(&mut candidates);
     }
-    // The best candidate, when its walls agree almost everywhere, is polished (only the best:
-    // on the 2048 bench pair polishing every RANSAC candidate cost about 35 ms).
+    // Whether a candidate's walls agree almost everywhere: the polish's case, which the
+    // spectrum angle and the ascent (made for noisy walls) leave alone.
+    let clean = |c: &Candidate| {
+        config
+            .polish
+            .is_some_and(|p| c.verification.wall_lift >= p.min_wall_lift)
+    };
+    // The best candidate, when clean, is polished (only the best: on the 2048 bench pair
+    // polishing every RANSAC candidate cost about 35 ms).
     if let Some(polish) = &config.polish
-        && let Some(best) = candidates
-            .first_mut()
-            .filter(|c| c.accepted && c.verification.wall_lift >= polish.min_wall_lift)
+        && let Some(best) = candidates.first_mut().filter(|c| c.accepted && clean(c))
     {
         let t = refine_with_bias(&pa, &pb, &best.transform, &polish.refine)
             .0
@@ -969,12 +974,7 @@ fn register_as_given(
     }
     // The best candidate's angle from the walls' Hough spectra (see `SpectrumRotation`).
     if let Some(sr) = &config.spectrum_rotation
-        && let Some(best) = candidates.first_mut().filter(|c| {
-            c.accepted
-                && config
-                    .polish
-                    .is_none_or(|p| c.verification.wall_lift < p.min_wall_lift)
-        })
+        && let Some(best) = candidates.first_mut().filter(|c| c.accepted && !clean(c))
         && wall_residual_px(&pa, &pb, &best.transform, 3.0, sr.max_points)
             .is_some_and(|r| r >= sr.min_wall_residual_px)
         && agreeing_wall_spread_px(&pa, &pb, &best.transform, 3.0)
@@ -1009,13 +1009,9 @@ fn register_as_given(
     // (walls that agree almost everywhere: ICP's pose is then sub-pixel, the score's counts at
     // whole cells are not) or stood out (the bars it passed are not those the score ranks).
     if let Some(ascent) = &config.ascent
-        && let Some(best) = candidates.first_mut().filter(|c| {
-            c.accepted
-                && !c.stands_out
-                && config
-                    .polish
-                    .is_none_or(|p| c.verification.wall_lift < p.min_wall_lift)
-        })
+        && let Some(best) = candidates
+            .first_mut()
+            .filter(|c| c.accepted && !c.stands_out && !clean(c))
     {
         let t0 = Instant::now();
         let (ta, tb) = rayon::join(|| wall_thickness(pa.grid), || wall_thickness(pb.grid));

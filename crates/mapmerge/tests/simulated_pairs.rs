@@ -58,22 +58,24 @@ fn disaster_30(seed: u64) -> Case {
 
 /// The sweep as it was before `SweepConfig::translation_peaks` and `screened`: one
 /// translation per angle, eight placements per ranking, none screened.
-fn with_former_sweep(mut config: RegisterConfig) -> RegisterConfig {
+fn with_former_sweep(config: &mut RegisterConfig) {
     let sweep = config.pair.sweep.as_mut().unwrap();
     (
         sweep.translation_peaks,
         sweep.keep_normalized,
         sweep.screened,
     ) = (1, 8, 0);
-    config
 }
 
-/// `case` is registered within 3 px with `with` and not without `what` (declined, or answered
-/// more than 3 px off), `without` being `with` less it.
-fn registered_only_with(case: &Case, with: &RegisterConfig, without: &RegisterConfig, what: &str) {
-    let error = registered(case, with).1;
+/// `case` is registered within 3 px with the default configuration and not without `what`
+/// (declined, or answered more than 3 px off): the default with `less` applied.
+fn registered_only_with(case: &Case, what: &str, less: impl FnOnce(&mut RegisterConfig)) {
+    let with = RegisterConfig::default();
+    let error = registered(case, &with).1;
     assert!(error.is_some_and(|e| e <= 3.0), "with {what}: {error:?} px");
-    let error = registered(case, without).1;
+    let mut without = with;
+    less(&mut without);
+    let error = registered(case, &without).1;
     assert!(
         error.is_none_or(|e| e > 3.0),
         "without {what}: {error:?} px (the test no longer shows what it adds)"
@@ -89,10 +91,9 @@ fn registered_only_with(case: &Case, with: &RegisterConfig, without: &RegisterCo
 /// kernel was widened.)
 #[test]
 fn a_disaster_pair_at_30_percent_overlap_is_registered_after_the_turn_search() {
-    let with = RegisterConfig::default();
-    let mut without = with.clone();
-    without.pair.turn_search = None;
-    registered_only_with(&disaster_30(7_000_019), &with, &without, "the turn search");
+    registered_only_with(&disaster_30(7_000_019), "the turn search", |c| {
+        c.pair.turn_search = None;
+    });
 }
 
 /// Case 17 of seed 8: declined when the sweep kept one translation per angle, eight placements
@@ -106,13 +107,10 @@ fn a_disaster_pair_at_30_percent_overlap_is_registered_after_the_turn_search() {
 /// until the frames.)
 #[test]
 fn a_disaster_pair_at_30_percent_overlap_is_registered_from_a_lesser_sweep_peak() {
-    let with = RegisterConfig::default();
-    let without = with_former_sweep(with.clone());
     registered_only_with(
         &disaster_30(8_000_017),
-        &with,
-        &without,
         "the sweep's lesser peaks and screen",
+        with_former_sweep,
     );
 }
 
@@ -125,10 +123,9 @@ fn a_disaster_pair_at_30_percent_overlap_is_registered_from_a_lesser_sweep_peak(
 /// frames (`PairConfig::frame_margin`), and now registers either way.
 #[test]
 fn a_disaster_pair_at_30_percent_overlap_is_registered_after_the_screen() {
-    let with = RegisterConfig::default();
-    let mut without = with.clone();
-    without.pair.sweep.as_mut().unwrap().screened = 0;
-    registered_only_with(&disaster_30(4_000_016), &with, &without, "the screen");
+    registered_only_with(&disaster_30(4_000_016), "the screen", |c| {
+        c.pair.sweep.as_mut().unwrap().screened = 0;
+    });
 }
 
 /// Case 14 of seed 7: declined when the sweep's translations of one angle were the local
@@ -139,10 +136,9 @@ fn a_disaster_pair_at_30_percent_overlap_is_registered_after_the_screen() {
 /// mapper's 120 registered, none lost; see docs/EVALUATION.md).
 #[test]
 fn a_disaster_pair_at_30_percent_overlap_is_registered_from_peaks_apart() {
-    let with = RegisterConfig::default();
-    let mut without = with.clone();
-    without.pair.sweep.as_mut().unwrap().peak_radius = 1;
-    registered_only_with(&disaster_30(7_000_014), &with, &without, "peaks apart");
+    registered_only_with(&disaster_30(7_000_014), "peaks apart", |c| {
+        c.pair.sweep.as_mut().unwrap().peak_radius = 1;
+    });
 }
 
 /// Case 19 of seed 8 of the disaster 30 % row mapped with hector's model (`cargo xtask eval
@@ -155,10 +151,7 @@ fn a_disaster_pair_at_30_percent_overlap_is_registered_from_peaks_apart() {
 #[test]
 fn a_hector_pair_at_30_percent_overlap_is_registered_after_the_ascent() {
     let case = disaster_case(8_000_019, 0.3, 0.1, InverseSensorModel::hector());
-    let with = RegisterConfig::default();
-    let mut without = with.clone();
-    without.pair.ascent = None;
-    registered_only_with(&case, &with, &without, "the ascent");
+    registered_only_with(&case, "the ascent", |c| c.pair.ascent = None);
 }
 
 /// Case 8 of seed 8 (the default mapper, whose walls are one cell thick and pushed behind the
@@ -168,15 +161,9 @@ fn a_hector_pair_at_30_percent_overlap_is_registered_after_the_ascent() {
 /// over seeds 7-9, 3 gained, 18 lost (docs/EVALUATION.md, "The score ascent").
 #[test]
 fn thin_walls_pushed_by_range_noise_are_not_climbed() {
-    let with = RegisterConfig::default();
-    let mut without = with.clone();
-    without.pair.ascent.as_mut().unwrap().min_wall_thickness = 0.0;
-    registered_only_with(
-        &disaster_30(8_000_008),
-        &with,
-        &without,
-        "the thickness gate",
-    );
+    registered_only_with(&disaster_30(8_000_008), "the thickness gate", |c| {
+        c.pair.ascent.as_mut().unwrap().min_wall_thickness = 0.0;
+    });
 }
 
 /// The basin rule and the stand-out rule were pinned on their cases below with walls compared
