@@ -836,9 +836,10 @@ pub struct SweepConfig {
     /// `screened` best and keeps the `keep_normalized` that then pass verification, or else
     /// that the maps agree with most ([`crate::verify::Verification::score`]; passing first
     /// since 2026-12-05, see "The screen keeps passing placements" in `docs/EVALUATION.md`).
-    /// `0` (or no more than `keep_normalized`) screens nothing. Default 100. In the disaster 30 % pairs of `cargo xtask eval --suites
-    /// overlap --only "overlap 0.3" --seed 3` and `--seed 4` with no candidate near the truth,
-    /// the placement near it ranked 18th-43rd by the normalised correlation and second once
+    /// `0` (or no more than `keep_normalized`) screens nothing. Default 100. In the disaster
+    /// 30 % pairs of `cargo xtask eval --suites overlap --only "overlap 0.3" --seed 3` and
+    /// `--seed 4` with no candidate near the truth, the placement near it ranked 18th-43rd by
+    /// the normalised correlation and second once
     /// searched and scored (3000005, 3000018, 4000016; scratch code). On that command,
     /// disaster 30 % at seeds 7, 3 and 4: 65, 25 and 45 % unscreened, 60, 30 and 50 % with 100
     /// screened (4 of the 5 pairs of seeds 3 and 4 with no candidate within 30 px of the truth

@@ -552,9 +552,9 @@ impl Placement {
 }
 
 /// The `keep` of `placements` that pass verification, or else that the maps agree with most,
-/// once the correlative local search (`config.search`, if any) has moved them ([`screen_order`]):
-/// a cheap screen before the full refinement, for a
-/// coarse ranking that puts the truth too far down (see [`SweepConfig::screened`]). Returns
+/// once the correlative local search (`config.search`, if any) has moved them
+/// ([`screen_order`]): a cheap screen before the full refinement, for a coarse ranking that
+/// puts the truth too far down (see [`SweepConfig::screened`]). Returns
 /// the placements themselves with where the search moved them, best screened first; all of
 /// them, in order and unsearched, when there are no more than `keep`. Deterministic: ties
 /// keep the given order.
