@@ -67,6 +67,11 @@ pub struct EvalArgs {
     /// turns the basin test off; default: the library's), to measure what it changes.
     #[arg(long)]
     basin_ratio: Option<f64>,
+    /// Override how much more wall in free space a rival may put than the best and still make
+    /// a pair ambiguous (`mapmerge::VerifyConfig::max_contradiction_excess`; default: the
+    /// library's), to measure what it changes.
+    #[arg(long)]
+    max_contradiction_excess: Option<f64>,
     /// Override the stand-out rule (`mapmerge::verify::StandOut`) as `LIFT,MARGIN`, its
     /// minimum wide wall lift and margin (default: the library's), to measure what it changes.
     #[arg(long, value_name = "LIFT,MARGIN", value_parser = stand_out_values, conflicts_with = "no_stand_out")]
@@ -536,6 +541,9 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
     let mut config = RegisterConfig::default();
     if let Some(r) = args.basin_ratio {
         config.pair.verify.basin_ratio = r;
+    }
+    if let Some(e) = args.max_contradiction_excess {
+        config.pair.verify.max_contradiction_excess = e;
     }
     if args.no_stand_out {
         config.pair.verify.stand_out = None;
