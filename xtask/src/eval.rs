@@ -79,6 +79,10 @@ pub struct EvalArgs {
     /// Turn the stand-out rule off.
     #[arg(long)]
     no_stand_out: bool,
+    /// Do not sweep the other way round when nothing passed (`mapmerge::global::SweepConfig::
+    /// reverse`), to measure what it changes.
+    #[arg(long)]
+    no_reverse_sweep: bool,
     /// Override how far from a wall unknown cells count as known where walls are compared
     /// (`mapmerge::VerifyConfig::shadow_px`, pixels; default: the library's), to measure what
     /// it changes.
@@ -547,6 +551,11 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
     }
     if args.no_stand_out {
         config.pair.verify.stand_out = None;
+    }
+    if args.no_reverse_sweep
+        && let Some(sweep) = config.pair.sweep.as_mut()
+    {
+        sweep.reverse = false;
     }
     if let Some(px) = args.shadow {
         config.pair.verify.shadow_px = px;

@@ -377,7 +377,8 @@ pub struct Timings {
     pub verify_ms: f64,
     /// Global search, when it ran.
     pub global_ms: f64,
-    /// Rotation sweep, when it ran.
+    /// Rotation sweep, when it ran (both ways round when the first found nothing that passes,
+    /// see `SweepConfig::reverse`).
     pub sweep_ms: f64,
     /// Symmetry probes of the best accepted candidate, when they ran.
     pub symmetry_ms: f64,
@@ -876,23 +877,47 @@ fn register_as_given(
             .iter()
             .any(|c| confident(c, sweep.confident_wall_lift))
     {
-        let (found, t) = search(
-            &|out| {
-                let found =
-                    sweep_placements(&pa, &pb, sweep, sweep.screened.max(sweep.keep_normalized));
-                out.extend(found.plain.into_iter().map(Placement::unsearched));
-                out.extend(screen(
-                    &pa,
-                    &pb,
-                    found.normalized,
-                    sweep.keep_normalized,
-                    config,
-                ));
-            },
-            Origin::Sweep,
-        );
+        // The sweep's placements with `moving`'s walls turned over `field`'s, as maps of B
+        // onto A (`back` turns them round when B is the field).
+        let swept = |field: &PreparedMap, moving: &PreparedMap, back: bool| {
+            let found = sweep_placements(
+                field,
+                moving,
+                sweep,
+                sweep.screened.max(sweep.keep_normalized),
+            );
+            let onto_a = |placements: Vec<Rigid2>| -> Vec<Rigid2> {
+                if back {
+                    placements
+                        .into_iter()
+                        .map(|t| t.inverse().normalized())
+                        .collect()
+                } else {
+                    placements
+                }
+            };
+            let mut out: Vec<Placement> = onto_a(found.plain)
+                .into_iter()
+                .map(Placement::unsearched)
+                .collect();
+            out.extend(screen(
+                &pa,
+                &pb,
+                onto_a(found.normalized),
+                sweep.keep_normalized,
+                config,
+            ));
+            out
+        };
+        let (found, t) = search(&|out| out.extend(swept(&pa, &pb, false)), Origin::Sweep);
         candidates.extend(found);
         timings.sweep_ms = t;
+        // Nothing passed: the other way round (see `SweepConfig::reverse`).
+        if sweep.reverse && !candidates.iter().any(|c| c.accepted) {
+            let (found, t) = search(&|out| out.extend(swept(&pb, &pa, true)), Origin::Sweep);
+            candidates.extend(found);
+            timings.sweep_ms += t;
+        }
     }
     // A whole-map placement kept where its search led, refined now that it matters.
     let settle = |c: &mut Candidate| {
