@@ -839,8 +839,8 @@ pub struct SweepConfig {
     /// `0` (or no more than `keep_normalized`) screens nothing. Default 100. In the disaster
     /// 30 % pairs of `cargo xtask eval --suites overlap --only "overlap 0.3" --seed 3` and
     /// `--seed 4` with no candidate near the truth, the placement near it ranked 18th-43rd by
-    /// the normalised correlation and second once
-    /// searched and scored (3000005, 3000018, 4000016; scratch code). On that command,
+    /// the normalised correlation and second once searched and scored (3000005, 3000018,
+    /// 4000016; scratch code). On that command,
     /// disaster 30 % at seeds 7, 3 and 4: 65, 25 and 45 % unscreened, 60, 30 and 50 % with 100
     /// screened (4 of the 5 pairs of seeds 3 and 4 with no candidate within 30 px of the truth
     /// got one within 5.2 px; seed 7's loss is case 7000013, 2.99 -> 3.11 px), 55, 30 and 50 %
@@ -891,8 +891,8 @@ pub struct SweepConfig {
     /// overlap differently: over the 30 % rows of `cargo xtask eval --suites overlap --only
     /// "overlap 0.3" --seed S` (S = 7-12) it registered 181 instead of 177 of the default
     /// mapper's 240 pairs (false accepts 52 -> 50) and 222 of hector's as before (false
-    /// accepts 8 -> 10, both 3.7-6.2 px off), the real floors (seeds 7-9) 109 instead of 107
-    /// of 240, and declined the same zero-overlap pairs (`--no-reverse-sweep`;
+    /// accepts 8 -> 10, both 3.7-6.2 px off), the default mapper's real floors (seeds 7-9) 109
+    /// instead of 107 of 240, hector's (seeds 8-9) as before, and declined the same zero-overlap pairs (`--no-reverse-sweep`;
     /// `docs/EVALUATION.md`, "The sweep the other way round"). Only pairs that would be
     /// declined pay for it: about 200 ms more per zero-overlap pair of the eval.
     pub reverse: bool,
