@@ -79,8 +79,8 @@ pub struct EvalArgs {
     /// Turn the stand-out rule off.
     #[arg(long)]
     no_stand_out: bool,
-    /// Do not sweep the other way round when nothing passed (`mapmerge::global::SweepConfig::
-    /// reverse`), to measure what it changes.
+    /// Do not sweep the other way round when nothing passed (`reverse` of
+    /// `mapmerge::global::SweepConfig`), to measure what it changes.
     #[arg(long)]
     no_reverse_sweep: bool,
     /// Override how far from a wall unknown cells count as known where walls are compared

@@ -21,9 +21,10 @@
 //! one refinement and scoring of a placement (`refine_and_score`: ICP with the range-bias
 //! offsets, then verification), one verification alone, the score ascent of an answer
 //! (`mapmerge::ascent`, which the hard pair's thin walls do not take) and its gate, the
-//! thickness of both maps' walls. The end-to-end time is about one
-//! sweep and the probes' correlations plus a few dozen placements each searched, refined and
-//! scored (see `timings_ms` of `mapmerge estimate --json`).
+//! thickness of both maps' walls. The end-to-end time is about one sweep and the probes'
+//! correlations plus a few dozen placements each searched, refined and scored (see
+//! `timings_ms` of `mapmerge estimate --json`). A pair where nothing passes pays for a second
+//! sweep, the other way round (`SweepConfig::reverse`); the three pairs here all pass.
 //!
 //! Run: `cargo bench -p mapmerge --bench register`.
 

@@ -3,11 +3,11 @@
 //! ICP ([`crate::refine`]) stops where its wall pairs balance, which with a narrow robust
 //! kernel need not be where the maps agree best: on maps whose walls stay in place but
 //! broken into speckle about two cells thick (a scan-matching mapper's, such as Hector's), the
-//! pairs that carry weight are the few cells that happen to coincide, and the fit can settle a few pixels off while the
-//! verification score ([`Verification::score`]) still rises all the way to the truth. The
-//! ascent climbs that score directly: from the pose, it tries a step along each axis and a
-//! turn each way about B's walls' centre, moves to the best that scores higher, and halves
-//! the step when none does.
+//! pairs that carry weight are the few cells that happen to coincide, and the fit can settle
+//! a few pixels off while the verification score ([`Verification::score`]) still rises all
+//! the way to the truth. The ascent climbs that score directly: from the pose, it tries a step
+//! along each axis and a turn each way about B's walls' centre, moves to the best that scores
+//! higher, and halves the step when none does.
 //!
 //! It is not for every map: where walls are thin and a noisy range sensor pushed them behind
 //! the obstacle faces, differently in each map, the score peaks where the pushed walls

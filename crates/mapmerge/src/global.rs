@@ -840,11 +840,10 @@ pub struct SweepConfig {
     /// 30 % pairs of `cargo xtask eval --suites overlap --only "overlap 0.3" --seed 3` and
     /// `--seed 4` with no candidate near the truth, the placement near it ranked 18th-43rd by
     /// the normalised correlation and second once searched and scored (3000005, 3000018,
-    /// 4000016; scratch code). On that command,
-    /// disaster 30 % at seeds 7, 3 and 4: 65, 25 and 45 % unscreened, 60, 30 and 50 % with 100
-    /// screened (4 of the 5 pairs of seeds 3 and 4 with no candidate within 30 px of the truth
-    /// got one within 5.2 px; seed 7's loss is case 7000013, 2.99 -> 3.11 px), 55, 30 and 50 %
-    /// keeping 12 of the 100; indoor 30 % unchanged (95, 85, 80 %). With the lesser peaks it
+    /// 4000016; scratch code). On that command, disaster 30 % at seeds 7, 3 and 4: 65, 25 and
+    /// 45 % unscreened, 60, 30 and 50 % with 100 screened (4 of the 5 pairs of seeds 3 and 4
+    /// with no candidate within 30 px of the truth got one within 5.2 px; seed 7's loss is case
+    /// 7000013, 2.99 -> 3.11 px), 55, 30 and 50 % keeping 12 of the 100; indoor 30 % unchanged (95, 85, 80 %). With the lesser peaks it
     /// raised the mean time per case of the eval table's rows by 10-60 % (`docs/EVALUATION.md`,
     /// "What the sweep's lesser peaks and the screen changed"). With passing placements first,
     /// 200 screened registered 2 pairs more and lost 3 over the 30 % rows at seeds 7-12 (both
@@ -894,9 +893,10 @@ pub struct SweepConfig {
     /// accepts 8 -> 10, both 3.7-6.2 px off), the default mapper's real floors (seeds 7-9) 109
     /// instead of 107 of 240, hector's (seeds 8-9) as before; of the zero-overlap pairs it
     /// accepted no more of the 281 of `--suites zero,noise --only "must decline"` (seeds 1, 2,
-    /// 3, 7: the same four as without) and one more of the 63 of the seed-7 table, 221 px off (`--no-reverse-sweep`;
-    /// `docs/EVALUATION.md`, "The sweep the other way round"). Only pairs that would be
-    /// declined pay for it: about 200 ms more per zero-overlap pair of the eval.
+    /// 3, 7: the same four as without) and one more of the 63 of the seed-7 table, 221 px off
+    /// (`--no-reverse-sweep`; `docs/EVALUATION.md`, "The sweep the other way round"). Only
+    /// pairs that would be declined pay for it: about 200 ms more per zero-overlap pair of the
+    /// eval.
     pub reverse: bool,
 }
 
