@@ -72,6 +72,11 @@ pub struct EvalArgs {
     /// library's), to measure what it changes.
     #[arg(long)]
     max_contradiction_excess: Option<f64>,
+    /// Override the share of its compared walls in the other map's free space above which an
+    /// answer is declined (`mapmerge::VerifyConfig::max_wall_contradiction`; `1` turns it off;
+    /// default: the library's), to measure what it changes.
+    #[arg(long)]
+    max_wall_contradiction: Option<f64>,
     /// Override the stand-out rule (`mapmerge::verify::StandOut`) as `LIFT,MARGIN`, its
     /// minimum wide wall lift and margin (default: the library's), to measure what it changes.
     #[arg(long, value_name = "LIFT,MARGIN", value_parser = stand_out_values, conflicts_with = "no_stand_out")]
@@ -548,6 +553,9 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
     }
     if let Some(e) = args.max_contradiction_excess {
         config.pair.verify.max_contradiction_excess = e;
+    }
+    if let Some(c) = args.max_wall_contradiction {
+        config.pair.verify.max_wall_contradiction = c;
     }
     if args.no_stand_out {
         config.pair.verify.stand_out = None;

@@ -1083,6 +1083,18 @@ fn register_as_given(
         );
         return declined(reason, timings, candidates);
     }
+    // An answer that leaves much of its wall in the other map's free space is declined (see
+    // `VerifyConfig::max_wall_contradiction`); it has served as a rival above.
+    if let Some(best) = candidates.first().filter(|b| b.accepted)
+        && best.verification.wall_contradiction > config.verify.max_wall_contradiction
+    {
+        let reason = format!(
+            "contradicted: {:.0} % of the best placement's compared walls lie in the other map's free space (at most {:.0} % accepted)",
+            100.0 * best.verification.wall_contradiction,
+            100.0 * config.verify.max_wall_contradiction
+        );
+        return declined(reason, timings, candidates);
+    }
     match candidates.first() {
         Some(best) if best.accepted => {
             // Inliers of the final (refined) transform, so the split by kind describes the answer.
@@ -1471,6 +1483,36 @@ mod tests {
         // Without the polish this copy came out 0.21 degrees off (0.02 with it).
         let err = rotation_error_deg(&best.transform, &truth);
         assert!(err < 0.1, "{err} degrees off");
+    }
+
+    #[test]
+    fn an_answer_with_much_wall_in_the_other_maps_free_space_is_declined() {
+        // B saw an obstacle A's robot saw through: a line of wall cells across A's free space,
+        // more than the wide tolerance from A's walls.
+        let a = room();
+        let mut cluttered = room();
+        let w = cluttered.width();
+        for x in 20..100 {
+            cluttered.cells_mut()[22 * w + x] = 100;
+        }
+        let (b, truth) = turned(&cluttered);
+        let with_bar = |bar: f64| {
+            let mut config = pair_config(true);
+            config.pair.verify.max_wall_contradiction = bar;
+            register(&a, &b, &config).unwrap()
+        };
+        let r = register(&a, &b, &pair_config(true)).unwrap();
+        let best = r
+            .accepted
+            .unwrap_or_else(|| panic!("declined: {:?}", r.reason));
+        assert!(displacement_error(&b, &best.transform, &truth).unwrap() < 1.0);
+        let c = best.verification.wall_contradiction;
+        assert!(c > 0.05 && c < 0.21, "contradiction {c}");
+        let declined = with_bar(c - 0.01);
+        assert!(declined.accepted.is_none());
+        let reason = declined.reason.unwrap();
+        assert!(reason.starts_with("contradicted: "), "{reason}");
+        assert!(with_bar(c + 0.01).accepted.is_some());
     }
 
     #[test]

@@ -80,6 +80,15 @@ pub struct VerifyConfig {
     /// a twin of a room with a little inner structure (a half wall, a pillar) fits the outer
     /// walls as well as the truth, but puts the inner structure in free space.
     pub max_contradiction_excess: f64,
+    /// The answer is declined when more than this share of its compared wall cells land in
+    /// the other map's free space ([`Verification::wall_contradiction`]): an obstacle where
+    /// the other robot saw through. Applied to the answer only, after the ambiguity test, so
+    /// such a placement still counts as a rival of the best. Default 0.21. Over the 1,044
+    /// accepted answers of `docs/EVALUATION.md`'s eval sets of 2026-12-05 (30 % overlap and
+    /// real floors with both mappers, zero overlap, the seed-7 table) no success exceeds
+    /// 0.195, and the two above 0.2 were a zero-overlap pair accepted 221 px off (0.233) and
+    /// an answer 7.2 px off (0.229). `1` or more turns it off.
+    pub max_wall_contradiction: f64,
     /// A placement that would be a rival of the best (see `max_ambiguity`) is not one when the
     /// placement halfway between the two scores at least this fraction of the poorer of them:
     /// no valley separates them, so they are one broad optimum (walls that a noisy sensor
@@ -186,6 +195,7 @@ impl Default for VerifyConfig {
             max_ambiguity: 0.6,
             distinct_px: 10.0,
             max_contradiction_excess: 0.05,
+            max_wall_contradiction: 0.21,
             basin_ratio: 0.9,
             stand_out: Some(StandOut::default()),
             shadow_px: 4.0,
