@@ -9,6 +9,10 @@
 //! overlap,zero,paper,real,noise --seed 7`), each on a 2048 x 2048 canvas. Few keypoints agree
 //! there, so the rotation sweep and the symmetry probes run: the hard case.
 //!
+//! `end_to_end_partial_maps_declined`: the same robots' partial maps of that floor sharing
+//! nothing (case 7_014_000 of the same floor with overlap 0), which must be declined: every
+//! stage runs, the sweep both ways round (`SweepConfig::reverse`), and nothing passes.
+//!
 //! `end_to_end_overlapping_crops`: two crops of the same floor, the western three quarters
 //! and the eastern three quarters (half of the floor's width shared), the second turned by 30
 //! degrees, each on a 2048 x 2048 canvas: a real-building pair that overlaps only in part but
@@ -24,7 +28,7 @@
 //! thickness of both maps' walls. The end-to-end time is about one sweep and the probes'
 //! correlations plus a few dozen placements each searched, refined and scored (see
 //! `timings_ms` of `mapmerge estimate --json`). A pair where nothing passes pays for a second
-//! sweep, the other way round (`SweepConfig::reverse`); the three pairs here all pass.
+//! sweep, the other way round (`SweepConfig::reverse`): the declined pair.
 //!
 //! Run: `cargo bench -p mapmerge --bench register`.
 
@@ -80,16 +84,16 @@ fn overlapping_crops() -> (OccupancyGrid, OccupancyGrid) {
     (a, b)
 }
 
-/// Two robots' partial maps of the uos_cic floor (see the module documentation), each moved
-/// onto a 2048 x 2048 canvas.
-fn partial_pair() -> (OccupancyGrid, OccupancyGrid) {
+/// Two robots' partial maps of the uos_cic floor sharing `overlap` of their known cells (see
+/// the module documentation), each moved onto a 2048 x 2048 canvas.
+fn partial_pair(overlap: f64) -> (OccupancyGrid, OccupancyGrid) {
     let path = concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/../../fixtures/maps/uos_cic/uos_cic.yaml"
     );
     let floor = load_map(path, &LoadOptions::default()).expect("fixture loads");
     let config = CaseConfig {
-        overlap: 0.5,
+        overlap,
         overlap_tolerance: f64::INFINITY,
         ..CaseConfig::floor(floor, &[0.1, 0.2])
     };
@@ -116,9 +120,16 @@ fn bench(c: &mut Criterion) {
     g.bench_function("end_to_end_overlapping_crops", |bn| {
         bn.iter(|| register(&ca, &cb, &config).expect("valid config"))
     });
-    let (pa, pb) = partial_pair();
+    let (pa, pb) = partial_pair(0.5);
     g.bench_function("end_to_end_partial_maps", |bn| {
         bn.iter(|| register(&pa, &pb, &config).expect("valid config"))
+    });
+    let (za, zb) = partial_pair(0.0);
+    // The bench times the declined path: check once that it is declined.
+    let answer = register(&za, &zb, &config).expect("valid config");
+    assert!(answer.accepted.is_none(), "accepted {:?}", answer.accepted);
+    g.bench_function("end_to_end_partial_maps_declined", |bn| {
+        bn.iter(|| register(&za, &zb, &config).expect("valid config"))
     });
     let sift = sift_desc::SiftCorrespondences::new(config.sift.clone()).expect("valid config");
     g.bench_function("sift_correspondences", |bn| {
