@@ -159,6 +159,10 @@ pub struct EvalArgs {
     /// The wall thickness both maps need for the ascent (`AscentConfig::min_wall_thickness`).
     #[arg(long, value_name = "CELLS")]
     ascent_min_thickness: Option<f64>,
+    /// How much the ascent's objective weighs a contradicting wall cell
+    /// (`AscentConfig::contradiction_weight`).
+    #[arg(long, value_name = "W")]
+    ascent_contradiction_weight: Option<f64>,
     /// Keep the best answer's angle from ICP instead of the walls' Hough spectra (to measure
     /// what `mapmerge::SpectrumRotation` adds).
     #[arg(long)]
@@ -645,6 +649,12 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
     }
     if let (Some(t), Some(ascent)) = (args.ascent_min_thickness, config.pair.ascent.as_mut()) {
         ascent.min_wall_thickness = t;
+    }
+    if let (Some(w), Some(ascent)) = (
+        args.ascent_contradiction_weight,
+        config.pair.ascent.as_mut(),
+    ) {
+        ascent.contradiction_weight = w;
     }
     if let Some(px) = args.search_sigma {
         for search in [&mut config.pair.search, &mut config.pair.turn_search]
