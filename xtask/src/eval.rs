@@ -216,6 +216,11 @@ pub struct EvalArgs {
     /// the library's), for calibration experiments.
     #[arg(long)]
     search_points: Option<usize>,
+    /// Override what the correlative local search subtracts per wall cell landing on known
+    /// cells far from the other map's walls, for both its searches
+    /// (`mapmerge::search::SearchConfig::free_penalty`; default: the library's).
+    #[arg(long)]
+    search_free_penalty: Option<f64>,
     /// Override how many wall cells per map every ICP refinement pairs while its gate shrinks
     /// (`mapmerge::refine::RefineConfig::coarse_points`; default: the library's). A number
     /// at least `max_points` (6000) uses all of them throughout, as before the coarse phase.
@@ -662,6 +667,14 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
             .flatten()
         {
             search.sigma_px = px;
+        }
+    }
+    if let Some(p) = args.search_free_penalty {
+        for search in [&mut config.pair.search, &mut config.pair.turn_search]
+            .into_iter()
+            .flatten()
+        {
+            search.free_penalty = p;
         }
     }
     if let Some(n) = args.search_points {

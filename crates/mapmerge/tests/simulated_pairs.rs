@@ -181,6 +181,25 @@ fn a_hector_pair_at_30_percent_overlap_is_registered_when_walls_in_free_space_we
     });
 }
 
+/// Case 2 of seed 12 of the disaster 30 % row mapped with hector's model (`cargo xtask eval
+/// --suites overlap --only "overlap 0.3" --mapper hector --seed 12`): the rotation sweep's
+/// first placement lies 4 px and 0.7 degrees from the truth, and the local search, scoring
+/// only walls that meet walls, slid it 8.8 px away towards more overlap, where it failed;
+/// nothing else passed and the pair was declined. With walls in the other map's free space
+/// costing the search (`SearchConfig::free_penalty`) it stays near and registers 1.9 px off.
+#[test]
+fn a_hector_pair_at_30_percent_overlap_is_registered_when_walls_in_free_space_cost_the_search() {
+    let case = disaster_case(12_000_002, 0.3, 0.1, InverseSensorModel::hector());
+    registered_only_with(&case, "the search's free penalty", |c| {
+        for search in [&mut c.pair.search, &mut c.pair.turn_search]
+            .into_iter()
+            .flatten()
+        {
+            search.free_penalty = 0.0;
+        }
+    });
+}
+
 /// Case 19 of seed 8: nothing the sweep proposes passes, and the pair was declined; the
 /// sweep the other way round (B's field, A's walls turned over it, `SweepConfig::reverse`)
 /// proposes a placement that registers 0.9 px off. Over the 30 % rows of seeds 7-12 it
@@ -210,15 +229,16 @@ fn thin_walls_pushed_by_range_noise_are_not_climbed() {
 /// the default since 2026-12-03) those cases no longer need them. Checks that the default
 /// registers `case` within 3 px, and returns the configuration without the shadow, where each
 /// rule is shown (and without the sweep the other way round, see [`one_way`]: for 8_001_004 it
-/// finds a placement that passes the bars without standing out).
-fn shadowless_after_default(case: &Case) -> RegisterConfig {
-    let (default, error) = registered(case, &RegisterConfig::default());
+/// finds a placement that passes the bars without standing out). `base` is the default, or
+/// the default with something a later change added taken out again (see the pins).
+fn shadowless_after(case: &Case, base: RegisterConfig) -> RegisterConfig {
+    let (default, error) = registered(case, &base);
     assert!(
         error.is_some_and(|e| e <= 3.0),
         "default: {error:?} px ({:?})",
         default.reason
     );
-    let mut config = RegisterConfig::default();
+    let mut config = base;
     config.pair.verify.shadow_px = 0.0;
     one_way(&mut config);
     config
@@ -234,11 +254,21 @@ fn shadowless_after_default(case: &Case) -> RegisterConfig {
 /// seeds 7 and 8 (the same command with `--shadow 0`, with and without `--basin-ratio 0`);
 /// case 8_001_006 showed it before (then answered 7.0 px off), and 7_001_019 before the local
 /// search's kernel was widened, a rival 11 px off and turned 3 degrees scoring 0.88 of the
-/// best. With the shadow the rival no longer scores as well: see [`shadowless_after_default`].
+/// best. With the shadow the rival no longer scores as well: see [`shadowless_after`]. Since
+/// walls in free space cost the local search (`SearchConfig::free_penalty`, 2026-12-05) the
+/// default answers this pair 4.1 px off (that row at seeds 7-9 lost one pair, 30 -> 29 of 60),
+/// so the pin runs with the search as it was (no penalty).
 #[test]
 fn a_rival_in_the_best_placements_basin_does_not_make_the_pair_ambiguous() {
     let case = disaster_case(8_001_002, 0.5, 0.3, InverseSensorModel::hector());
-    let config = shadowless_after_default(&case);
+    let mut base = RegisterConfig::default();
+    for search in [&mut base.pair.search, &mut base.pair.turn_search]
+        .into_iter()
+        .flatten()
+    {
+        search.free_penalty = 0.0;
+    }
+    let config = shadowless_after(&case, base);
     let (with, error) = registered(&case, &config);
     assert!(
         error.is_some_and(|e| e <= 3.0),
@@ -260,13 +290,13 @@ fn a_rival_in_the_best_placements_basin_does_not_make_the_pair_ambiguous() {
 /// reaches the wall lift bars, but the one nearest the truth stands out from every placement
 /// more than 20 px from it. The stand-out rule (`VerifyConfig::stand_out`) accepts it; without
 /// the rule the pair is declined. With the shadow the placement passes the bars by itself: see
-/// [`shadowless_after_default`]. (Case 7_003_000 of `--suites zero,noise` showed it until the
+/// [`shadowless_after`]. (Case 7_003_000 of `--suites zero,noise` showed it until the
 /// frames, `PairConfig::frame_margin`; found again with the eval's `--shadow 0` and
 /// `--no-stand-out`.)
 #[test]
 fn a_placement_that_stands_out_on_speckled_walls_is_accepted() {
     let case = disaster_case(8_001_004, 0.5, 0.3, InverseSensorModel::hector());
-    let config = shadowless_after_default(&case);
+    let config = shadowless_after(&case, RegisterConfig::default());
     let (with, error) = registered(&case, &config);
     assert!(
         error.is_some_and(|e| e <= 3.0) && with.accepted.is_some_and(|c| c.stands_out),
