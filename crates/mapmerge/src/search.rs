@@ -8,7 +8,10 @@
 //! every pose of a coarse-to-fine grid around the hypothesis on both maps' walls, as
 //! correlative scan matching does (Olson 2009): each wall cell of one map adds
 //! `exp(-d^2 / 2 sigma^2)` for the distance `d` to the nearest wall of the other map (nothing
-//! where that map is unknown), in both directions. The pose with the highest score wins; ties
+//! where that map is unknown), in both directions, less [`SearchConfig::free_penalty`] where
+//! `d` exceeds two kernel widths on known cells (a wall where the other robot saw free
+//! space), so that a placement does not gain by sliding towards more overlap whatever its
+//! walls land on. The pose with the highest score wins; ties
 //! keep the hypothesis. The window is small, so the search improves a hypothesis; it cannot
 //! make a wrong one right.
 //!

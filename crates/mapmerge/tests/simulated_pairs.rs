@@ -168,7 +168,7 @@ fn a_hector_pair_at_30_percent_overlap_is_registered_after_the_ascent() {
 
 /// Case 15 of seed 10 of the disaster 30 % row mapped with hector's model (`cargo xtask eval
 /// --suites overlap --only "overlap 0.3" --mapper hector --seed 10`): the plain score climbs to
-/// a pose 5.4 px off that compares 2,862 wall cells and puts 7.8 % of them in the other map's
+/// a pose 5.4 px off that compares 2,861 wall cells and puts 7.7 % of them in the other map's
 /// free space, over the truth's basin (2,334 cells, 0.5 %); counted against the pose
 /// (`AscentConfig::contradiction_weight`), those walls keep the climb at 1.1 px. Over hector's
 /// 30 % rows at seeds 7-12 the weight registered 7 such pairs and lost 1 (docs/EVALUATION.md,
