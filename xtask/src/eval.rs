@@ -662,26 +662,17 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
         ascent.contradiction_weight = w;
     }
     if let Some(px) = args.search_sigma {
-        for search in [&mut config.pair.search, &mut config.pair.turn_search]
-            .into_iter()
-            .flatten()
-        {
+        for search in config.pair.searches_mut() {
             search.sigma_px = px;
         }
     }
     if let Some(p) = args.search_free_penalty {
-        for search in [&mut config.pair.search, &mut config.pair.turn_search]
-            .into_iter()
-            .flatten()
-        {
+        for search in config.pair.searches_mut() {
             search.free_penalty = p;
         }
     }
     if let Some(n) = args.search_points {
-        for search in [&mut config.pair.search, &mut config.pair.turn_search]
-            .into_iter()
-            .flatten()
-        {
+        for search in config.pair.searches_mut() {
             search.max_points = n;
         }
     }

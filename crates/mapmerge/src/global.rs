@@ -843,9 +843,10 @@ pub struct SweepConfig {
     /// 4000016; scratch code). On that command, disaster 30 % at seeds 7, 3 and 4: 65, 25 and
     /// 45 % unscreened, 60, 30 and 50 % with 100 screened (4 of the 5 pairs of seeds 3 and 4
     /// with no candidate within 30 px of the truth got one within 5.2 px; seed 7's loss is case
-    /// 7000013, 2.99 -> 3.11 px), 55, 30 and 50 % keeping 12 of the 100; indoor 30 % unchanged (95, 85, 80 %). With the lesser peaks it
-    /// raised the mean time per case of the eval table's rows by 10-60 % (`docs/EVALUATION.md`,
-    /// "What the sweep's lesser peaks and the screen changed"). With passing placements first,
+    /// 7000013, 2.99 -> 3.11 px), 55, 30 and 50 % keeping 12 of the 100; indoor 30 % unchanged
+    /// (95, 85, 80 %). With the lesser peaks it raised the mean time per case of the eval
+    /// table's rows by 10-60 % (`docs/EVALUATION.md`, "What the sweep's lesser peaks and the
+    /// screen changed"). With passing placements first,
     /// 200 screened registered 2 pairs more and lost 3 over the 30 % rows at seeds 7-12 (both
     /// mappers), and accepted two answers 215 and 412 px off (`--sweep-screen 200`), so 100
     /// stays.

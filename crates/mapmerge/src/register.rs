@@ -271,6 +271,13 @@ impl PairConfig {
     pub fn frame(&self, grid: &OccupancyGrid) -> Option<(OccupancyGrid, DVec2)> {
         self.frame_margin.map(|margin| framed(grid, margin))
     }
+
+    /// The correlative local searches that are on: [`Self::search`] and [`Self::turn_search`].
+    pub fn searches_mut(&mut self) -> impl Iterator<Item = &mut SearchConfig> {
+        [&mut self.search, &mut self.turn_search]
+            .into_iter()
+            .flatten()
+    }
 }
 
 impl Default for PairConfig {

@@ -74,6 +74,13 @@ fn one_way(config: &mut RegisterConfig) {
     config.pair.sweep.as_mut().unwrap().reverse = false;
 }
 
+/// The local searches as they were before `SearchConfig::free_penalty` (2026-12-05).
+fn without_free_penalty(config: &mut RegisterConfig) {
+    for search in config.pair.searches_mut() {
+        search.free_penalty = 0.0;
+    }
+}
+
 /// `case` is registered within 3 px with the default configuration and not without `what`
 /// (declined, or answered more than 3 px off): the default with `less` applied.
 fn registered_only_with(case: &Case, what: &str, less: impl FnOnce(&mut RegisterConfig)) {
@@ -190,14 +197,7 @@ fn a_hector_pair_at_30_percent_overlap_is_registered_when_walls_in_free_space_we
 #[test]
 fn a_hector_pair_at_30_percent_overlap_is_registered_when_walls_in_free_space_cost_the_search() {
     let case = disaster_case(12_000_002, 0.3, 0.1, InverseSensorModel::hector());
-    registered_only_with(&case, "the search's free penalty", |c| {
-        for search in [&mut c.pair.search, &mut c.pair.turn_search]
-            .into_iter()
-            .flatten()
-        {
-            search.free_penalty = 0.0;
-        }
-    });
+    registered_only_with(&case, "the search's free penalty", without_free_penalty);
 }
 
 /// Case 19 of seed 8: nothing the sweep proposes passes, and the pair was declined; the
@@ -262,12 +262,7 @@ fn shadowless_after(case: &Case, base: RegisterConfig) -> RegisterConfig {
 fn a_rival_in_the_best_placements_basin_does_not_make_the_pair_ambiguous() {
     let case = disaster_case(8_001_002, 0.5, 0.3, InverseSensorModel::hector());
     let mut base = RegisterConfig::default();
-    for search in [&mut base.pair.search, &mut base.pair.turn_search]
-        .into_iter()
-        .flatten()
-    {
-        search.free_penalty = 0.0;
-    }
+    without_free_penalty(&mut base);
     let config = shadowless_after(&case, base);
     let (with, error) = registered(&case, &config);
     assert!(
