@@ -143,24 +143,49 @@ fn shifted_score(turned: &[DVec2], onto: &PreparedMap, shift: DVec2, k: &Kernel)
     s
 }
 
+/// Fractional bits of the fixed-point coordinates of [`shifted_scores`].
+const FRACTION_BITS: u32 = 20;
+
+/// `v` in fixed point with [`FRACTION_BITS`] fractional bits (truncated), clamped to a billion
+/// pixels either way so that a point plus a shift cannot overflow.
+#[inline]
+fn fixed(v: f64) -> i64 {
+    (v.clamp(-1e9, 1e9) * (1u64 << FRACTION_BITS) as f64) as i64
+}
+
 /// [`shifted_score`] for each of `shifts`, in order, with the same sums (each adds the points
 /// in order). Point by point rather than shift by shift: the cells one point visits over the
 /// shifts lie close together, so they stay in the nearest cache.
+///
+/// Points and shifts are added in fixed point ([`FRACTION_BITS`]): an integer sum, a shift
+/// and one unsigned test per axis instead of a floating-point sum, two conversions and four
+/// tests. The cell differs from that of the floating-point sum only where the sum lies within
+/// about a millionth of a pixel of a cell's edge. The turn search took 1.0 instead of 1.6 ms
+/// (`cargo bench -p mapmerge --bench register -- turn_search`).
 fn shifted_scores(turned: &[DVec2], onto: &PreparedMap, shifts: &[DVec2], k: &Kernel) -> Vec<f32> {
     let mut sums = vec![0.0f32; shifts.len()];
     // Each point moved once by the half cell of rounding and the window's origin, so that a
     // shifted point's window cell is its coordinates truncated, where they lie in the window:
     // the same cells as `known_wall_quarters` but where a point lies within rounding of a
-    // cell's edge.
+    // cell's edge. A negative sum wraps to beyond the window's sides.
     let (x0, y0, w, h) = onto.walls.window();
     let corner = DVec2::new(0.5 - x0 as f64, 0.5 - y0 as f64);
-    let (wf, hf) = (w as f64, h as f64);
+    let (w_fixed, h_fixed) = ((w as u64) << FRACTION_BITS, (h as u64) << FRACTION_BITS);
+    let shifts: Vec<(i64, i64)> = shifts.iter().map(|s| (fixed(s.x), fixed(s.y))).collect();
     for &r in turned {
         let r = r + corner;
-        for (s, &shift) in sums.iter_mut().zip(shifts) {
-            let q = r + shift;
-            if q.x >= 0.0 && q.y >= 0.0 && q.x < wf && q.y < hf {
-                *s += k.at(onto.known_quarters_at(q.y as usize * w + q.x as usize));
+        if !r.is_finite() {
+            continue;
+        }
+        let (rx, ry) = (fixed(r.x), fixed(r.y));
+        for (s, &(sx, sy)) in sums.iter_mut().zip(&shifts) {
+            let (qx, qy) = ((rx + sx) as u64, (ry + sy) as u64);
+            if qx < w_fixed && qy < h_fixed {
+                let (x, y) = (
+                    (qx >> FRACTION_BITS) as usize,
+                    (qy >> FRACTION_BITS) as usize,
+                );
+                *s += k.at(onto.known_quarters_at(y * w + x));
             }
         }
     }
@@ -192,9 +217,10 @@ fn lattice_scores(
         };
         let (cx, cy) = (cx as i64 - x0 as i64, cy as i64 - y0 as i64);
         for (s, &(dx, dy)) in sums.iter_mut().zip(steps) {
-            let (x, y) = (cx + dx, cy + dy);
-            if x >= 0 && y >= 0 && (x as usize) < w && (y as usize) < h {
-                *s += k.at(onto.known_quarters_at(y as usize * w + x as usize));
+            // A negative coordinate wraps to beyond any side: one test per axis.
+            let (x, y) = ((cx + dx) as u64 as usize, (cy + dy) as u64 as usize);
+            if x < w && y < h {
+                *s += k.at(onto.known_quarters_at(y * w + x));
             }
         }
     }
