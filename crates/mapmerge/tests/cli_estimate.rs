@@ -180,9 +180,26 @@ fn bad_input_is_refused_with_exit_2() {
         "{err}"
     );
 
-    // The debug picture never overwrites an input.
+    // The debug picture never overwrites an input: the map given, or the image its YAML
+    // names.
     let err = fails(&[a_s, a_s, "--debug-png", a_s]);
     assert!(err.contains("would overwrite an input map"), "{err}");
+    // (On copies, so that a failure cannot spoil the fixture.)
+    let copy = dir.path().join("wpi_ilab.yaml");
+    let image = dir.path().join("wpi_ilab.pgm");
+    std::fs::copy(&a, &copy).unwrap();
+    std::fs::copy(a.with_extension("pgm"), &image).unwrap();
+    let before = std::fs::read(&image).unwrap();
+    let copy_s = copy.to_str().unwrap();
+    let err = fails(&[copy_s, copy_s, "--debug-png", image.to_str().unwrap()]);
+    assert_eq!(
+        err,
+        format!(
+            "mapmerge: error: {}: --debug-png would overwrite an input map; choose another file",
+            image.display()
+        )
+    );
+    assert_eq!(std::fs::read(&image).unwrap(), before);
     // Nor is it attempted (after the registration's work) in a directory that does not exist.
     let nowhere = dir.path().join("no_such_dir").join("matches.png");
     let err = fails(&[a_s, a_s, "--debug-png", nowhere.to_str().unwrap()]);

@@ -79,16 +79,24 @@ fn same_file(a: &Path, b: &Path) -> bool {
     }
 }
 
+/// A usage error when `png` is one of `inputs`.
+fn refuse_overwriting<'a>(
+    png: &Path,
+    inputs: impl IntoIterator<Item = &'a PathBuf>,
+) -> Result<(), UsageError> {
+    if inputs.into_iter().any(|input| same_file(png, input)) {
+        return Err(UsageError(format!(
+            "{}: --debug-png would overwrite an input map; choose another file",
+            png.display()
+        )));
+    }
+    Ok(())
+}
+
 /// Run `mapmerge estimate`.
 pub fn run(args: &EstimateArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode> {
     if let Some(png) = &args.debug_png {
-        if same_file(png, &args.a) || same_file(png, &args.b) {
-            return Err(UsageError(format!(
-                "{}: --debug-png would overwrite an input map; choose another file",
-                png.display()
-            ))
-            .into());
-        }
+        refuse_overwriting(png, [&args.a, &args.b])?;
         // Checked before the registration's work, not after it.
         let dir = png.parent().filter(|d| !d.as_os_str().is_empty());
         if let Some(dir) = dir.filter(|d| !d.is_dir()) {
@@ -102,6 +110,10 @@ pub fn run(args: &EstimateArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode
     }
     let a = load(&args.a, bare)?;
     let b = load(&args.b, bare)?;
+    if let Some(png) = &args.debug_png {
+        // A map given by its YAML is read from the image the YAML names.
+        refuse_overwriting(png, [&a.image_path, &b.image_path])?;
+    }
     grid_core::io::require_known_cells(&a.grid, &args.a)?;
     grid_core::io::require_known_cells(&b.grid, &args.b)?;
     let (ra, rb) = (a.grid.resolution(), b.grid.resolution());
