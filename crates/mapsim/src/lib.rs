@@ -177,9 +177,10 @@ pub struct CaseConfig {
 /// walls. The default (`free` -1.4, `occupied` 2.2: cell probabilities 0.2 and 0.9) clears
 /// hard, so under strong noise obstacles that beams read past fade away. Hector mapping's
 /// defaults (`update_factor_free` 0.4, `update_factor_occupied` 0.9: log-odds -0.405 and
-/// 2.197, [`Self::hector`]) and OctoMap's (0.4 and 0.7) clear gently, so a noisy wall stays
-/// as a band of speckle: the same sensor gives another map, and registration should do on
-/// both.
+/// 2.197, [`Self::hector`]) clear gently, so a noisy wall stays as a band of speckle: the same
+/// sensor gives another map, and registration should do on both. OctoMap's (0.4 and 0.7,
+/// [`Self::octomap`]) lies between in the ratio of a hit to a pass but, its hit being small,
+/// keeps about as little of a noisy wall as the default.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct InverseSensorModel {
     /// Log-odds added to each cell a beam passes through. Default -1.4.
@@ -207,6 +208,19 @@ impl InverseSensorModel {
             free: (0.4f32 / 0.6).ln(),
             occupied: (0.9f32 / 0.1).ln(),
             clamp: 5.0,
+        }
+    }
+
+    /// OctoMap's defaults: cell probabilities 0.4 for a pass, 0.7 for a hit, log-odds
+    /// clamped at 3.5 (OctoMap's upper clamping threshold, probability 0.97; its lower one,
+    /// 0.12, is -2.0, and this model's clamp is symmetric). A hit outweighs two passes, but a
+    /// cell hit once and passed once reads unknown (0.85 - 0.41 is below the occupied
+    /// threshold), so under strong noise it keeps about as little wall as the default.
+    pub fn octomap() -> Self {
+        Self {
+            free: (0.4f32 / 0.6).ln(),
+            occupied: (0.7f32 / 0.3).ln(),
+            clamp: 3.5,
         }
     }
 }

@@ -202,6 +202,26 @@ fn a_gentle_mapper_keeps_noisy_walls_as_speckle() {
 }
 
 #[test]
+fn octomaps_mapper_clears_noisy_walls_about_as_hard_as_the_default() {
+    use mapsim::InverseSensorModel;
+    // Measured (seeds 0-2, 30 % noise): 3792 occupied cells with the default model, 3225 with
+    // OctoMap's, 11700 with hector's. A hit outweighs two of OctoMap's passes, but its hit is
+    // small: a cell hit once and passed once reads unknown (0.85 - 0.41), where the default's
+    // still reads occupied (2.2 - 1.4).
+    let noisy = |model| occupied_cells(0.3, model);
+    let cells = (
+        noisy(InverseSensorModel::default()),
+        noisy(InverseSensorModel::octomap()),
+        noisy(InverseSensorModel::hector()),
+    );
+    assert!(
+        cells.1 < cells.0 && 3 * cells.1 < cells.2,
+        "at 30 % noise OctoMap's model keeps less wall than the default, far less than \
+         hector's: {cells:?}"
+    );
+}
+
+#[test]
 fn an_inverse_model_that_does_not_clear_is_refused() {
     let mut config = CaseConfig::default();
     config.inverse_model.free = 0.0;
