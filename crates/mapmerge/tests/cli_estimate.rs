@@ -246,9 +246,27 @@ fn debug_png_is_written() {
         let b = load_map(fixture(second), &LoadOptions::default()).unwrap();
         // Three panels: A, B and the overlay in A's frame, 10 px apart.
         let (wa, wb) = (a.width() as u32, b.width() as u32);
-        assert_eq!(
-            (img.width(), img.height()),
-            (2 * wa + wb + 20, a.height().max(b.height()) as u32)
+        assert!(img.height() >= a.height().max(b.height()) as u32);
+        // The overlay shows both maps whole: about as many of its pixels are walls of A (blue
+        // or black where B's agree) and of B (red or black) as the maps have wall cells (B's
+        // turned and sampled at the nearest cell).
+        let occupied = |m: &OccupancyGrid| {
+            (0..m.height())
+                .flat_map(|y| (0..m.width()).map(move |x| (x, y)))
+                .filter(|&(x, y)| m.state(x, y) == CellState::Occupied)
+                .count() as f64
+        };
+        let (mut walls_a, mut walls_b) = (0.0, 0.0);
+        for (x, _, p) in img.enumerate_pixels() {
+            if x >= wa + wb + 20 {
+                walls_a += f64::from(u8::from(p.0 == [40, 80, 230] || p.0 == [0, 0, 0]));
+                walls_b += f64::from(u8::from(p.0 == [230, 40, 40] || p.0 == [0, 0, 0]));
+            }
+        }
+        let (ra, rb) = (walls_a / occupied(&a), walls_b / occupied(&b));
+        assert!(
+            (0.99..=1.01).contains(&ra) && (0.97..=1.03).contains(&rb),
+            "{first} {second}: the overlay shows {ra:.3} of A's walls, {rb:.3} of B's"
         );
         // B's panel is whole: its known cells show as free (white) or occupied (black) where
         // the panel puts them, except under the match lines drawn across it (3-4 % here).

@@ -63,7 +63,7 @@ pub struct EstimateArgs {
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// Write a picture of A, B with the matches (green: inliers, red: outliers) and B laid
-    /// over A with the answer (A's walls blue, B's red, agreeing walls black)
+    /// over A with the answer, both whole (A's walls blue, B's red, agreeing walls black)
     #[arg(long, value_name = "FILE")]
     pub debug_png: Option<PathBuf>,
 }
@@ -287,7 +287,42 @@ fn line(img: &mut image::RgbImage, p: DVec2, q: DVec2, colour: [u8; 3]) {
     }
 }
 
-/// Three panels: A, B (with match lines between them), and B laid over A with the answer.
+/// The bounding box `(x0, y0, x1, y1)` (inclusive, pixels of A's frame) of A's known cells
+/// and of B's placed by `t`, grown by a few pixels; A's whole canvas when neither map has a
+/// known cell.
+fn overlay_bounds(a: &OccupancyGrid, b: &OccupancyGrid, t: &Rigid2) -> (i64, i64, i64, i64) {
+    const MARGIN: usize = 5;
+    let mut corners = Vec::new();
+    if let Some((x, y, w, h)) = a.known_bounds(MARGIN) {
+        corners.push(DVec2::new(x as f64, y as f64));
+        corners.push(DVec2::new((x + w - 1) as f64, (y + h - 1) as f64));
+    }
+    if let Some((x, y, w, h)) = b.known_bounds(MARGIN) {
+        let (x1, y1) = ((x + w - 1) as f64, (y + h - 1) as f64);
+        for (cx, cy) in [
+            (x as f64, y as f64),
+            (x1, y as f64),
+            (x as f64, y1),
+            (x1, y1),
+        ] {
+            corners.push(t.apply(DVec2::new(cx, cy)));
+        }
+    }
+    if corners.is_empty() {
+        return (0, 0, a.width() as i64 - 1, a.height() as i64 - 1);
+    }
+    let lo = corners.iter().copied().reduce(DVec2::min).expect("corners");
+    let hi = corners.iter().copied().reduce(DVec2::max).expect("corners");
+    (
+        lo.x.floor() as i64,
+        lo.y.floor() as i64,
+        hi.x.ceil() as i64,
+        hi.y.ceil() as i64,
+    )
+}
+
+/// Three panels: A, B (with match lines between them), and B laid over A with the answer, both
+/// whole.
 fn write_debug_png(
     path: &Path,
     a: &OccupancyGrid,
@@ -297,8 +332,26 @@ fn write_debug_png(
 ) -> anyhow::Result<()> {
     const GAP: usize = 10;
     let (wa, ha, wb, hb) = (a.width(), a.height(), b.width(), b.height());
-    let width = 2 * wa + wb + 2 * GAP;
-    let height = ha.max(hb);
+    let t = r
+        .accepted
+        .as_ref()
+        .map(|c| c.transform)
+        .or_else(|| r.candidates.first().map(|c| c.transform));
+    // The overlay covers the known cells of both maps, B's placed by the answer, in A's frame:
+    // its top left pixel is A's pixel `(x0, y0)`.
+    let overlay = t.map(|t| {
+        let (mut x0, mut y0, mut x1, mut y1) = overlay_bounds(a, b, &t);
+        // A placement far from A (a declined pair's best candidate can be anywhere) would make
+        // a picture of mostly nothing: A's canvas then.
+        let area = (x1 - x0 + 1) as f64 * (y1 - y0 + 1) as f64;
+        if area > 4.0 * ((wa * ha).max(wb * hb)) as f64 {
+            (x0, y0, x1, y1) = (0, 0, wa as i64 - 1, ha as i64 - 1);
+        }
+        (t, x0, y0, (x1 - x0 + 1) as usize, (y1 - y0 + 1) as usize)
+    });
+    let (wo, ho) = overlay.map_or((0, 0), |(_, _, _, w, h)| (w, h));
+    let width = wa + wb + wo + 2 * GAP;
+    let height = ha.max(hb).max(ho);
     anyhow::ensure!(
         (width as u64) * (height as u64) <= 200_000_000,
         "{}: the debug picture would be {width} x {height} pixels; too large",
@@ -317,29 +370,27 @@ fn write_debug_png(
             img.put_pixel((bx + x) as u32, y as u32, image::Rgb(shade(b.state(x, y))));
         }
     }
-    let t = r
-        .accepted
-        .as_ref()
-        .map(|c| c.transform)
-        .or_else(|| r.candidates.first().map(|c| c.transform));
     for c in &r.matches {
         let inlier = t.is_some_and(|t: Rigid2| (c.a - t.apply(c.b)).length() <= threshold);
         let colour = if inlier { [0, 170, 0] } else { [220, 40, 40] };
         line(&mut img, c.a, c.b + DVec2::new(bx as f64, 0.0), colour);
     }
-    // Overlay in A's frame, right of B's panel.
+    // Overlay right of B's panel.
     let ox = bx + wb + GAP;
-    if let Some(t) = t {
+    if let Some((t, x0, y0, wo, ho)) = overlay {
         let inv = t.inverse();
-        for y in 0..ha {
-            for x in 0..wa {
-                let q = inv.apply(DVec2::new(x as f64, y as f64)).round();
-                let sb = if q.x >= 0.0 && q.y >= 0.0 {
-                    b.state(q.x as usize, q.y as usize)
-                } else {
-                    CellState::Unknown
-                };
-                let sa = a.state(x, y);
+        let state = |grid: &OccupancyGrid, q: DVec2| {
+            let q = q.round();
+            if q.x >= 0.0 && q.y >= 0.0 && q.x < grid.width() as f64 && q.y < grid.height() as f64 {
+                grid.state(q.x as usize, q.y as usize)
+            } else {
+                CellState::Unknown
+            }
+        };
+        for v in 0..ho {
+            for u in 0..wo {
+                let p = DVec2::new((x0 + u as i64) as f64, (y0 + v as i64) as f64);
+                let (sa, sb) = (state(a, p), state(b, inv.apply(p)));
                 let colour = match (sa, sb) {
                     (CellState::Occupied, CellState::Occupied) => [0, 0, 0],
                     (CellState::Occupied, _) => [40, 80, 230],
@@ -347,7 +398,7 @@ fn write_debug_png(
                     (CellState::Free, _) | (_, CellState::Free) => [255, 255, 255],
                     _ => [205, 205, 205],
                 };
-                img.put_pixel((ox + x) as u32, y as u32, image::Rgb(colour));
+                img.put_pixel((ox + u) as u32, v as u32, image::Rgb(colour));
             }
         }
     }
