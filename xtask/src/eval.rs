@@ -235,9 +235,10 @@ pub struct EvalArgs {
     /// (`mapmerge::refine::RefineConfig::tolerance_px`; default: the library's).
     #[arg(long)]
     refine_tolerance: Option<f64>,
-    /// How the simulated robots fold their beams into their maps (`default`, or `hector`:
-    /// gentle clearing, so noisy walls stay as speckle; see `cargo xtask gen --help`). Row
-    /// labels name a mapper other than the default.
+    /// How the simulated robots fold their beams into their maps (`default`; `hector`: gentle
+    /// clearing, so noisy walls stay as speckle; `octomap`: OctoMap's probabilities, never
+    /// tuned on; see `cargo xtask gen --help`). Row labels name a mapper other than the
+    /// default.
     #[arg(long, value_enum, default_value = "default")]
     mapper: Mapper,
     /// Only the rows whose label contains this text (e.g. `"overlap 0.3"`).
