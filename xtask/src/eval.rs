@@ -72,6 +72,11 @@ pub struct EvalArgs {
     /// library's), to measure what it changes.
     #[arg(long)]
     max_contradiction_excess: Option<f64>,
+    /// Override by how much a placement's wide wall lift must exceed the best's to make it a
+    /// rival however little it scores (`mapmerge::VerifyConfig::rival_wide_lift_margin`;
+    /// `inf` turns it off; default: the library's), to measure what it changes.
+    #[arg(long)]
+    rival_wide_margin: Option<f64>,
     /// Override the share of its compared walls in the other map's free space above which an
     /// answer is declined (`mapmerge::VerifyConfig::max_wall_contradiction`; `1` turns it off;
     /// default: the library's), to measure what it changes.
@@ -516,6 +521,24 @@ fn rows(suites: &[String], size: usize, mapper: Mapper) -> Result<Vec<Row>> {
             expect_decline: false,
         });
     }
+    if want("real") {
+        // A warehouse (the nav2 depot: shelf rows that repeat), two robots of one model at the
+        // issue's smallest overlap. Listed last, so that every other row keeps its cases.
+        let yaml = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+            .join("../fixtures/maps/nav2_depot/nav2_depot.yaml");
+        let grid = grid_core::io::load_map(&yaml, &grid_core::io::LoadOptions::default())
+            .with_context(|| format!("loading {}", yaml.display()))?;
+        rows.push(Row {
+            suite: "real",
+            label: "nav2_depot world, overlap 0.3, noise 10%/10%".into(),
+            config: case(
+                world(WorldKind::Grid(grid), 0),
+                vec![lidar(0.10), lidar(0.10)],
+                0.3,
+            ),
+            expect_decline: false,
+        });
+    }
     anyhow::ensure!(!rows.is_empty(), "no known suite in {suites:?}");
     if mapper != Mapper::Default {
         for row in &mut rows {
@@ -573,6 +596,9 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
     let mut config = RegisterConfig::default();
     if let Some(r) = args.basin_ratio {
         config.pair.verify.basin_ratio = r;
+    }
+    if let Some(m) = args.rival_wide_margin {
+        config.pair.verify.rival_wide_lift_margin = m;
     }
     if let Some(e) = args.max_contradiction_excess {
         config.pair.verify.max_contradiction_excess = e;

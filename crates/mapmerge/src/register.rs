@@ -439,8 +439,9 @@ impl KindTotals {
 
 /// Whether candidate `c`, placed clearly apart from the best (`best` its scores), is a rival
 /// that makes the pair ambiguous ([`VerifyConfig::max_ambiguity`]): it passes, scores almost
-/// as well or fits its (smaller) overlap at least as well, and does not put clearly more
-/// walls into the other map's free space ([`VerifyConfig::max_contradiction_excess`]).
+/// as well or fits its (smaller) overlap at least as well (wall lift as high, or wide wall
+/// lift clearly higher, [`VerifyConfig::rival_wide_lift_margin`]), and does not put clearly
+/// more walls into the other map's free space ([`VerifyConfig::max_contradiction_excess`]).
 ///
 /// A twin from the symmetry probes is judged by the same rule. At 9c48d15 every twin that
 /// passed was a rival, which declined exact copies of small rooms whose quarter-turned twin
@@ -448,7 +449,9 @@ impl KindTotals {
 fn rivals(best: &Verification, c: &Candidate, config: &VerifyConfig) -> bool {
     let v = &c.verification;
     c.accepted
-        && (v.score() >= config.max_ambiguity * best.score() || v.wall_lift >= best.wall_lift)
+        && (v.score() >= config.max_ambiguity * best.score()
+            || v.wall_lift >= best.wall_lift
+            || v.wide_wall_lift > best.wide_wall_lift + config.rival_wide_lift_margin)
         && v.wall_contradiction <= best.wall_contradiction + config.max_contradiction_excess
 }
 
@@ -1083,11 +1086,23 @@ fn register_as_given(
         })
     });
     if let (Some(best), Some(rival)) = (candidates.first(), rival) {
-        let reason = format!(
-            "ambiguous: two different placements fit almost equally well (scores {:.0} and {:.0}); the maps share too little distinctive structure",
-            best.verification.score(),
-            rival.verification.score()
-        );
+        let (b, r) = (&best.verification, &rival.verification);
+        let reason = if r.score() >= config.verify.max_ambiguity * b.score()
+            || r.wall_lift >= b.wall_lift
+        {
+            format!(
+                "ambiguous: two different placements fit almost equally well (scores {:.0} and {:.0}); the maps share too little distinctive structure",
+                b.score(),
+                r.score()
+            )
+        } else {
+            format!(
+                "ambiguous: the best placement (score {:.0}) lays more walls over walls, but another fits its smaller overlap clearly better (wide wall lift {:.2} against {:.2}); repeated structure fits more than one way",
+                b.score(),
+                r.wide_wall_lift,
+                b.wide_wall_lift
+            )
+        };
         return declined(reason, timings, candidates);
     }
     // An answer that leaves much of its wall in the other map's free space is declined (see
@@ -1418,6 +1433,21 @@ mod tests {
             ..twin(best)
         };
         assert!(!rivals(&best, &failed, &config));
+        // A warehouse turned by a quarter (nav2 depot, see
+        // `VerifyConfig::rival_wide_lift_margin`): the best lays twice the walls, a placement
+        // near the truth fits its walls at 4 px clearly better (0.97 against 0.86).
+        let wide = |lift: f64, support: usize, contradiction: f64, wide: f64| Verification {
+            wide_wall_lift: wide,
+            ..scores(lift, support, contradiction)
+        };
+        let best = wide(0.77, 859, 0.121, 0.855);
+        assert!(rivals(&best, &twin(wide(0.67, 485, 0.025, 0.971)), &config));
+        // Not when its wide lift is higher by 0.05 or less.
+        assert!(!rivals(
+            &best,
+            &twin(wide(0.67, 485, 0.025, 0.905)),
+            &config
+        ));
     }
 
     #[test]

@@ -433,3 +433,39 @@ fn a_pair_drawn_by_octomaps_mapper_is_registered() {
         r.reason
     );
 }
+
+/// Case 7 of `cargo xtask gen --world fixtures/maps/nav2_depot/nav2_depot.yaml --overlap 0.3
+/// --seed 11 --count 8` (the paper preset's robots in the nav2 depot, a warehouse whose shelf
+/// rows repeat): the best placement is a quarter turn off, laying twice the truth's walls (wall
+/// lift 0.77, wide 0.86, 12 % in free space), and a placement 2.5 px from the truth fits its
+/// smaller overlap clearly better (0.67, 0.97, 2.5 %) but scores half as much. It makes the
+/// pair ambiguous (`VerifyConfig::rival_wide_lift_margin`): declined rather than answered
+/// 300 px off.
+#[test]
+fn a_warehouse_pair_whose_best_placement_is_a_quarter_turn_off_is_declined() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../fixtures/maps/nav2_depot/nav2_depot.yaml"
+    );
+    let depot = grid_core::io::load_map(path, &Default::default()).unwrap();
+    let mut config = CaseConfig::paper();
+    config.world.resolution = depot.resolution();
+    config.world.kind = WorldKind::Grid(depot);
+    config.overlap = 0.3;
+    let case = generate_case(&config, 18).unwrap();
+    let (r, error) = registered(&case, &RegisterConfig::default());
+    assert!(
+        r.reason
+            .as_deref()
+            .is_some_and(|reason| reason.contains("fits its smaller overlap clearly better")),
+        "error {error:?}, reason {:?}",
+        r.reason
+    );
+    let mut without = RegisterConfig::default();
+    without.pair.verify.rival_wide_lift_margin = f64::INFINITY;
+    let (_, error) = registered(&case, &without);
+    assert!(
+        error.is_some_and(|e| e > 200.0),
+        "without the rule: {error:?}"
+    );
+}
