@@ -449,10 +449,15 @@ impl KindTotals {
 fn rivals(best: &Verification, c: &Candidate, config: &VerifyConfig) -> bool {
     let v = &c.verification;
     c.accepted
-        && (v.score() >= config.max_ambiguity * best.score()
-            || v.wall_lift >= best.wall_lift
+        && (fits_about_as_well(best, v, config)
             || v.wide_wall_lift > best.wide_wall_lift + config.rival_wide_lift_margin)
         && v.wall_contradiction <= best.wall_contradiction + config.max_contradiction_excess
+}
+
+/// Whether `v` scores almost as well as `best` ([`VerifyConfig::max_ambiguity`]) or fits its
+/// walls at least as well (wall lift as high).
+fn fits_about_as_well(best: &Verification, v: &Verification, config: &VerifyConfig) -> bool {
+    v.score() >= config.max_ambiguity * best.score() || v.wall_lift >= best.wall_lift
 }
 
 /// Whether placements `x` and `y` are one broad optimum rather than two answers: the placement
@@ -1087,9 +1092,7 @@ fn register_as_given(
     });
     if let (Some(best), Some(rival)) = (candidates.first(), rival) {
         let (b, r) = (&best.verification, &rival.verification);
-        let reason = if r.score() >= config.verify.max_ambiguity * b.score()
-            || r.wall_lift >= b.wall_lift
-        {
+        let reason = if fits_about_as_well(b, r, &config.verify) {
             format!(
                 "ambiguous: two different placements fit almost equally well (scores {:.0} and {:.0}); the maps share too little distinctive structure",
                 b.score(),
