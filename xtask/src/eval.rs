@@ -72,11 +72,11 @@ pub struct EvalArgs {
     /// library's), to measure what it changes.
     #[arg(long)]
     max_contradiction_excess: Option<f64>,
-    /// Override by how much a placement's wide wall lift must exceed the best's to make it a
-    /// rival however little it scores (`mapmerge::VerifyConfig::rival_wide_lift_margin`;
-    /// `inf` turns it off; default: the library's), to measure what it changes.
+    /// Override the wide wall lift below which every clearly different placement that passes
+    /// rivals the best (`mapmerge::VerifyConfig::trusted_wide_wall_lift`; `0` turns it off;
+    /// default: the library's), to measure what it changes.
     #[arg(long)]
-    rival_wide_margin: Option<f64>,
+    trusted_wide_lift: Option<f64>,
     /// Override the share of its compared walls in the other map's free space above which an
     /// answer is declined (`mapmerge::VerifyConfig::max_wall_contradiction`; `1` turns it off;
     /// default: the library's), to measure what it changes.
@@ -597,8 +597,8 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
     if let Some(r) = args.basin_ratio {
         config.pair.verify.basin_ratio = r;
     }
-    if let Some(m) = args.rival_wide_margin {
-        config.pair.verify.rival_wide_lift_margin = m;
+    if let Some(w) = args.trusted_wide_lift {
+        config.pair.verify.trusted_wide_wall_lift = w;
     }
     if let Some(e) = args.max_contradiction_excess {
         config.pair.verify.max_contradiction_excess = e;

@@ -439,9 +439,9 @@ impl KindTotals {
 
 /// Whether candidate `c`, placed clearly apart from the best (`best` its scores), is a rival
 /// that makes the pair ambiguous ([`VerifyConfig::max_ambiguity`]): it passes, scores almost
-/// as well or fits its (smaller) overlap at least as well (wall lift as high, or wide wall
-/// lift clearly higher, [`VerifyConfig::rival_wide_lift_margin`]), and does not put clearly
-/// more walls into the other map's free space ([`VerifyConfig::max_contradiction_excess`]).
+/// as well or fits its (smaller) overlap at least as well, or the best itself fits below
+/// [`VerifyConfig::trusted_wide_wall_lift`], and it does not put clearly more walls into the
+/// other map's free space ([`VerifyConfig::max_contradiction_excess`]).
 ///
 /// A twin from the symmetry probes is judged by the same rule. At 9c48d15 every twin that
 /// passed was a rival, which declined exact copies of small rooms whose quarter-turned twin
@@ -450,7 +450,7 @@ fn rivals(best: &Verification, c: &Candidate, config: &VerifyConfig) -> bool {
     let v = &c.verification;
     c.accepted
         && (fits_about_as_well(best, v, config)
-            || v.wide_wall_lift > best.wide_wall_lift + config.rival_wide_lift_margin)
+            || best.wide_wall_lift < config.trusted_wide_wall_lift)
         && v.wall_contradiction <= best.wall_contradiction + config.max_contradiction_excess
 }
 
@@ -1100,10 +1100,11 @@ fn register_as_given(
             )
         } else {
             format!(
-                "ambiguous: the best placement (score {:.0}) lays more walls over walls, but another fits its smaller overlap clearly better (wide wall lift {:.2} against {:.2}); repeated structure fits more than one way",
+                "ambiguous: the best placement fits imperfectly (wide wall lift {:.2}, score {:.0}) and a clearly different one passes too (wide wall lift {:.2}, score {:.0}); repeated structure fits more than one way",
+                b.wide_wall_lift,
                 b.score(),
                 r.wide_wall_lift,
-                b.wide_wall_lift
+                r.score()
             )
         };
         return declined(reason, timings, candidates);
@@ -1404,8 +1405,11 @@ mod tests {
 
     #[test]
     fn a_twin_is_a_rival_only_if_it_fits_about_as_well() {
+        // The wide wall lift (walls within 4 px) as the lift: no less, and the same for walls
+        // that fit within 2 px.
         let scores = |lift: f64, support: usize, contradiction: f64| Verification {
             wall_lift: lift,
+            wide_wall_lift: lift,
             wall_support: support,
             wall_contradiction: contradiction,
             acceptance_index: 0.99,
@@ -1437,20 +1441,17 @@ mod tests {
         };
         assert!(!rivals(&best, &failed, &config));
         // A warehouse turned by a quarter (nav2 depot, see
-        // `VerifyConfig::rival_wide_lift_margin`): the best lays twice the walls, a placement
-        // near the truth fits its walls at 4 px clearly better (0.97 against 0.86).
+        // `VerifyConfig::trusted_wide_wall_lift`): the best lays twice the walls but fits them
+        // imperfectly (wide wall lift 0.86), so a placement near the truth that passes at half
+        // its score is a rival; against a best that fits every wall (the exact copy above,
+        // wide 1.0) it is not.
         let wide = |lift: f64, support: usize, contradiction: f64, wide: f64| Verification {
             wide_wall_lift: wide,
             ..scores(lift, support, contradiction)
         };
-        let best = wide(0.77, 859, 0.121, 0.855);
-        assert!(rivals(&best, &twin(wide(0.67, 485, 0.025, 0.971)), &config));
-        // Not when its wide lift is higher by 0.05 or less.
-        assert!(!rivals(
-            &best,
-            &twin(wide(0.67, 485, 0.025, 0.905)),
-            &config
-        ));
+        let near_truth = twin(wide(0.67, 485, 0.025, 0.971));
+        assert!(rivals(&wide(0.77, 859, 0.121, 0.855), &near_truth, &config));
+        assert!(!rivals(&wide(1.0, 1300, 0.0, 1.0), &near_truth, &config));
     }
 
     #[test]
