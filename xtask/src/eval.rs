@@ -12,7 +12,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use grid_core::metrics::{displacement_error, rotation_error_deg};
-use grid_core::{DVec2, Rigid2};
+use grid_core::{DVec2, OccupancyGrid, Rigid2};
 use indicatif::{ProgressBar, ProgressStyle};
 use mapmerge::search::SearchConfig;
 use mapmerge::verify::{PreparedMap, verify};
@@ -384,6 +384,16 @@ fn case(world: WorldConfig, robots: Vec<RobotConfig>, overlap: f64) -> CaseConfi
     }
 }
 
+/// The map `fixtures/maps/NAME/NAME.yaml`, a real floor the real suite's robots explore.
+fn fixture_floor(name: &str) -> Result<OccupancyGrid> {
+    let yaml = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../fixtures/maps")
+        .join(name)
+        .join(format!("{name}.yaml"));
+    grid_core::io::load_map(&yaml, &grid_core::io::LoadOptions::default())
+        .with_context(|| format!("loading {}", yaml.display()))
+}
+
 fn rows(suites: &[String], size: usize, mapper: Mapper) -> Result<Vec<Row>> {
     let all = suites.iter().any(|s| s == "all");
     let want = |name: &str| all || suites.iter().any(|s| s == name);
@@ -468,12 +478,8 @@ fn rows(suites: &[String], size: usize, mapper: Mapper) -> Result<Vec<Row>> {
         });
     }
     if want("real") {
-        let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../fixtures/maps");
         for name in ["wpi_ilab", "aws_small_house", "uos_cic", "intel_lab"] {
-            let dir = root.join(name);
-            let yaml = dir.join(format!("{name}.yaml"));
-            let grid = grid_core::io::load_map(&yaml, &grid_core::io::LoadOptions::default())
-                .with_context(|| format!("loading {}", yaml.display()))?;
+            let grid = fixture_floor(name)?;
             rows.push(Row {
                 suite: "real",
                 label: format!("{name} world, overlap 0.5, noise 10%/20%"),
@@ -524,10 +530,7 @@ fn rows(suites: &[String], size: usize, mapper: Mapper) -> Result<Vec<Row>> {
     if want("real") {
         // A warehouse (the nav2 depot: shelf rows that repeat), two robots of one model at the
         // issue's smallest overlap. Listed last, so that every other row keeps its cases.
-        let yaml = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-            .join("../fixtures/maps/nav2_depot/nav2_depot.yaml");
-        let grid = grid_core::io::load_map(&yaml, &grid_core::io::LoadOptions::default())
-            .with_context(|| format!("loading {}", yaml.display()))?;
+        let grid = fixture_floor("nav2_depot")?;
         rows.push(Row {
             suite: "real",
             label: "nav2_depot world, overlap 0.3, noise 10%/10%".into(),

@@ -160,7 +160,7 @@ fn fixed(v: f64) -> i64 {
 /// Points and shifts are added in fixed point ([`FRACTION_BITS`]): an integer sum, a shift
 /// and one unsigned test per axis instead of a floating-point sum, two conversions and four
 /// tests. The cell differs from that of the floating-point sum only where the sum lies within
-/// about a millionth of a pixel of a cell's edge. The turn search took 1.0 instead of 1.6 ms
+/// about a millionth of a pixel of a cell's edge. The turn search took 1.0 instead of 1.5 ms
 /// (`cargo bench -p mapmerge --bench register -- turn_search`).
 fn shifted_scores(turned: &[DVec2], onto: &PreparedMap, shifts: &[DVec2], k: &Kernel) -> Vec<f32> {
     let mut sums = vec![0.0f32; shifts.len()];
