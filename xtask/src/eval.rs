@@ -82,6 +82,16 @@ pub struct EvalArgs {
     /// default: the library's), to measure what it changes.
     #[arg(long)]
     max_wall_contradiction: Option<f64>,
+    /// Override the wall lift from which an answer's walls count as crisp and are held to the
+    /// misfit bar (`mapmerge::VerifyConfig::crisp_wall_lift`; above `1` turns the rule off;
+    /// default: the library's), to measure what it changes.
+    #[arg(long)]
+    crisp_wall_lift: Option<f64>,
+    /// Override the share of a crisp answer's misfit walls that may lie in the other map's
+    /// free space (`mapmerge::VerifyConfig::max_misfit_contradiction`; default: the
+    /// library's), to measure what it changes.
+    #[arg(long)]
+    max_misfit_contradiction: Option<f64>,
     /// Override the stand-out rule (`mapmerge::verify::StandOut`) as `LIFT,MARGIN`, its
     /// minimum wide wall lift and margin (default: the library's), to measure what it changes.
     #[arg(long, value_name = "LIFT,MARGIN", value_parser = stand_out_values, conflicts_with = "no_stand_out")]
@@ -608,6 +618,12 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
     }
     if let Some(c) = args.max_wall_contradiction {
         config.pair.verify.max_wall_contradiction = c;
+    }
+    if let Some(l) = args.crisp_wall_lift {
+        config.pair.verify.crisp_wall_lift = l;
+    }
+    if let Some(m) = args.max_misfit_contradiction {
+        config.pair.verify.max_misfit_contradiction = m;
     }
     if args.no_stand_out {
         config.pair.verify.stand_out = None;

@@ -1110,16 +1110,28 @@ fn register_as_given(
         return declined(reason, timings, candidates);
     }
     // An answer that leaves much of its wall in the other map's free space is declined (see
-    // `VerifyConfig::max_wall_contradiction`); it has served as a rival above.
-    if let Some(best) = candidates.first().filter(|b| b.accepted)
-        && best.verification.wall_contradiction > config.verify.max_wall_contradiction
-    {
-        let reason = format!(
-            "contradicted: {:.0} % of the best placement's compared walls lie in the other map's free space (at most {:.0} % accepted)",
-            100.0 * best.verification.wall_contradiction,
-            100.0 * config.verify.max_wall_contradiction
-        );
-        return declined(reason, timings, candidates);
+    // `VerifyConfig::max_wall_contradiction` and `crisp_wall_lift`); it has served as a rival
+    // above.
+    if let Some(best) = candidates.first().filter(|b| b.accepted) {
+        let v = &best.verification;
+        let bar = v.contradiction_bar(&config.verify);
+        if v.wall_contradiction > bar {
+            let reason = if bar < config.verify.max_wall_contradiction {
+                format!(
+                    "contradicted: the best placement lays walls on walls crisply (wall lift {:.2}) yet puts {:.1} % of its compared walls in the other map's free space (at most {:.1} % accepted at that fit); it matches part of a layout that repeats, not the overlap",
+                    v.wall_lift,
+                    100.0 * v.wall_contradiction,
+                    100.0 * bar
+                )
+            } else {
+                format!(
+                    "contradicted: {:.0} % of the best placement's compared walls lie in the other map's free space (at most {:.0} % accepted)",
+                    100.0 * v.wall_contradiction,
+                    100.0 * bar
+                )
+            };
+            return declined(reason, timings, candidates);
+        }
     }
     match candidates.first() {
         Some(best) if best.accepted => {

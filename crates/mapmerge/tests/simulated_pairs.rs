@@ -463,9 +463,61 @@ fn a_warehouse_pair_whose_best_placement_is_a_quarter_turn_off_is_declined() {
     );
     let mut without = RegisterConfig::default();
     without.pair.verify.trusted_wide_wall_lift = 0.0;
+    // The best would fail the crisp-walls bar too (12 % in free space at lift 0.77).
+    without.pair.verify.crisp_wall_lift = 2.0;
     let (_, error) = registered(&case, &without);
     assert!(
         error.is_some_and(|e| e > 200.0),
         "without the rule: {error:?}"
+    );
+}
+
+/// Case 7004003 of the warehouse row of `cargo xtask eval --suites real --seed 7` (two lidar
+/// robots with 10 % range noise in the nav2 depot at 30 % overlap): the best placement is the
+/// truth turned by a quarter, laying B's long wall precisely on A's end wall (wall lift 0.86)
+/// while 6 % of its walls lie in A's free space, and no placement near the truth is found to
+/// rival it. Walls that fit that crisply may leave at most 0.28 of their misfit in free space
+/// (`VerifyConfig::crisp_wall_lift`): declined rather than answered 310 px off.
+#[test]
+fn a_warehouse_pair_matched_by_crisp_walls_a_quarter_turn_off_is_declined() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../fixtures/maps/nav2_depot/nav2_depot.yaml"
+    );
+    let depot = grid_core::io::load_map(path, &Default::default()).unwrap();
+    let config = CaseConfig {
+        world: WorldConfig {
+            kind: WorldKind::Grid(depot),
+            width: 0,
+            height: 0,
+            ..WorldConfig::default()
+        },
+        robots: vec![
+            RobotConfig {
+                noise_bound: 0.1,
+                ..RobotConfig::default()
+            };
+            2
+        ],
+        overlap: 0.3,
+        overlap_tolerance: f64::INFINITY,
+        ..CaseConfig::default()
+    };
+    let case = generate_case(&config, 7_004_003).unwrap();
+    let (r, error) = registered(&case, &RegisterConfig::default());
+    assert!(
+        r.reason
+            .as_deref()
+            .is_some_and(|reason| reason.contains("lays walls on walls crisply")),
+        "error {error:?}, reason {:?}",
+        r.reason
+    );
+    let mut without = RegisterConfig::default();
+    without.pair.verify.crisp_wall_lift = 2.0;
+    let (r, error) = registered(&case, &without);
+    assert!(
+        error.is_some_and(|e| e > 200.0),
+        "without the rule: {error:?}, reason {:?}",
+        r.reason
     );
 }
