@@ -88,10 +88,15 @@ pub struct EvalArgs {
     #[arg(long)]
     crisp_wall_lift: Option<f64>,
     /// Override the share of a crisp answer's misfit walls that may lie in the other map's
-    /// free space (`mapmerge::VerifyConfig::max_misfit_contradiction`; default: the
+    /// free space both ways (`mapmerge::VerifyConfig::max_misfit_contradiction`; default: the
     /// library's), to measure what it changes.
     #[arg(long)]
     max_misfit_contradiction: Option<f64>,
+    /// Override the least share of a crisp answer's walls that may lie in the other map's free
+    /// space both ways (`mapmerge::VerifyConfig::min_crisp_contradiction`; default: the
+    /// library's), to measure what it changes.
+    #[arg(long)]
+    min_crisp_contradiction: Option<f64>,
     /// Override the stand-out rule (`mapmerge::verify::StandOut`) as `LIFT,MARGIN`, its
     /// minimum wide wall lift and margin (default: the library's), to measure what it changes.
     #[arg(long, value_name = "LIFT,MARGIN", value_parser = stand_out_values, conflicts_with = "no_stand_out")]
@@ -624,6 +629,9 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
     }
     if let Some(m) = args.max_misfit_contradiction {
         config.pair.verify.max_misfit_contradiction = m;
+    }
+    if let Some(m) = args.min_crisp_contradiction {
+        config.pair.verify.min_crisp_contradiction = m;
     }
     if args.no_stand_out {
         config.pair.verify.stand_out = None;

@@ -1114,22 +1114,23 @@ fn register_as_given(
     // above.
     if let Some(best) = candidates.first().filter(|b| b.accepted) {
         let v = &best.verification;
-        let bar = v.contradiction_bar(&config.verify);
-        if v.wall_contradiction > bar {
-            let reason = if bar < config.verify.max_wall_contradiction {
-                format!(
-                    "contradicted: the best placement lays walls on walls crisply (wall lift {:.2}) yet puts {:.1} % of its compared walls in the other map's free space (at most {:.1} % accepted at that fit); it matches part of a layout that repeats, not the overlap",
-                    v.wall_lift,
-                    100.0 * v.wall_contradiction,
-                    100.0 * bar
-                )
-            } else {
-                format!(
-                    "contradicted: {:.0} % of the best placement's compared walls lie in the other map's free space (at most {:.0} % accepted)",
-                    100.0 * v.wall_contradiction,
-                    100.0 * bar
-                )
-            };
+        if v.wall_contradiction > config.verify.max_wall_contradiction {
+            let reason = format!(
+                "contradicted: {:.0} % of the best placement's compared walls lie in the other map's free space (at most {:.0} % accepted)",
+                100.0 * v.wall_contradiction,
+                100.0 * config.verify.max_wall_contradiction
+            );
+            return declined(reason, timings, candidates);
+        }
+        if let Some(bar) = v.crisp_contradiction_bar(&config.verify)
+            && v.mutual_contradiction > bar
+        {
+            let reason = format!(
+                "contradicted: the best placement lays walls on walls crisply (wall lift {:.2}) yet each map puts {:.1} % or more of its compared walls in the other's free space (at most {:.1} % accepted at that fit); it matches part of a layout that repeats, not the overlap",
+                v.wall_lift,
+                100.0 * v.mutual_contradiction,
+                100.0 * bar
+            );
             return declined(reason, timings, candidates);
         }
     }

@@ -463,7 +463,7 @@ fn a_warehouse_pair_whose_best_placement_is_a_quarter_turn_off_is_declined() {
     );
     let mut without = RegisterConfig::default();
     without.pair.verify.trusted_wide_wall_lift = 0.0;
-    // The best would fail the crisp-walls bar too (12 % in free space at lift 0.77).
+    // The best would fail the crisp-walls bar too (lift 0.77, 12 % of walls in free space).
     without.pair.verify.crisp_wall_lift = 2.0;
     let (_, error) = registered(&case, &without);
     assert!(
@@ -475,9 +475,10 @@ fn a_warehouse_pair_whose_best_placement_is_a_quarter_turn_off_is_declined() {
 /// Case 7004003 of the warehouse row of `cargo xtask eval --suites real --seed 7` (two lidar
 /// robots with 10 % range noise in the nav2 depot at 30 % overlap): the best placement is the
 /// truth turned by a quarter, laying B's long wall precisely on A's end wall (wall lift 0.86)
-/// while 6 % of its walls lie in A's free space, and no placement near the truth is found to
-/// rival it. Walls that fit that crisply may leave at most 0.28 of their misfit in free space
-/// (`VerifyConfig::crisp_wall_lift`): declined rather than answered 310 px off.
+/// while each map puts 5.6 % of its compared walls in the other's free space, and no
+/// placement near the truth is found to rival it. Walls that fit that crisply may leave at
+/// most 0.25 of their misfit in free space both ways (`VerifyConfig::crisp_wall_lift`):
+/// declined rather than answered 310 px off.
 #[test]
 fn a_warehouse_pair_matched_by_crisp_walls_a_quarter_turn_off_is_declined() {
     let path = concat!(
