@@ -26,7 +26,8 @@ use crate::picture;
 /// Arguments of `cargo xtask eval`.
 #[derive(Debug, clap::Args)]
 pub struct EvalArgs {
-    /// Suites to run (comma separated): overlap, zero, noise, mismatch, paper, real, or `all`.
+    /// Suites to run (comma separated): overlap, zero, noise, mismatch, paper, real, large (the
+    /// nav2 warehouse, maps about 1800 x 900 cells; slow to simulate), or `all`.
     #[arg(long, value_delimiter = ',', default_value = "overlap,zero")]
     suites: Vec<String>,
     /// Cases per suite row.
@@ -549,6 +550,23 @@ fn rows(suites: &[String], size: usize, mapper: Mapper) -> Result<Vec<Row>> {
         rows.push(Row {
             suite: "real",
             label: "nav2_depot world, overlap 0.3, noise 10%/10%".into(),
+            config: case(
+                world(WorldKind::Grid(grid), 0),
+                vec![lidar(0.10), lidar(0.10)],
+                0.3,
+            ),
+            expect_decline: false,
+        });
+    }
+    if want("large") {
+        // A large floor (the nav2 warehouse: 1006 x 1674 cells of 3 cm, long shelving rows),
+        // two robots of one model at the smallest overlap: maps about 1800 x 900 cells,
+        // where a tenth of a degree moves the far walls by a pixel or more. Its own suite,
+        // since each case takes seconds to simulate.
+        let grid = fixture_floor("nav2_warehouse")?;
+        rows.push(Row {
+            suite: "large",
+            label: "nav2_warehouse world, overlap 0.3, noise 10%/10%".into(),
             config: case(
                 world(WorldKind::Grid(grid), 0),
                 vec![lidar(0.10), lidar(0.10)],

@@ -97,6 +97,18 @@ const EXPECTED: &[Expected] = &[
         occupied: 5947,
         unknown: 0,
     },
+    // 254:1318485, 205:230801, 255:103807, 0:30951. Its YAML has free_thresh 0.1: 254 (p =
+    // 0.004) and 255 (p = 0) are free, 205 (p = 0.196) unknown.
+    Expected {
+        name: "nav2_warehouse",
+        width: 1006,
+        height: 1674,
+        resolution: 0.03,
+        origin: [-15.1, -25.0, 0.0],
+        free: 1318485 + 103807,
+        occupied: 30951,
+        unknown: 230801,
+    },
     // RGBA PNG, alpha 255 everywhere. `histogram.py` gives channel sums (mean = sum / 3):
     // 615/3 = 205 → unknown: 895788; 758/3 = 252.7 and 765/3 = 255 → free: 456730 + 71320;
     // 10/3 = 3.3 and 0/3 = 0 → occupied: 23346 + 276. Same as PROVENANCE.md's buckets.

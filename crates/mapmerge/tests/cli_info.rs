@@ -130,6 +130,18 @@ fn info_json_on_every_fixture() {
             5947,
             0,
         ),
+        // free_thresh 0.1 in its YAML: 254 and 255 are free, 205 unknown.
+        (
+            "nav2_warehouse",
+            "pgm",
+            1006,
+            1674,
+            0.03,
+            [-15.1, -25.0, 0.0],
+            1318485 + 103807,
+            30951,
+            230801,
+        ),
         (
             "uos_cic",
             "png",
@@ -162,6 +174,8 @@ fn info_json_on_every_fixture() {
             (0.2, 0.05)
         } else if name == "nav2_depot" {
             (0.65, 0.25)
+        } else if name == "nav2_warehouse" {
+            (0.65, 0.1)
         } else {
             (0.65, 0.196)
         };
