@@ -237,6 +237,12 @@ pub struct EvalArgs {
     /// the library's), for calibration experiments.
     #[arg(long)]
     search_points: Option<usize>,
+    /// Override how far the overlap's wall centroid must lie from all of B's walls' for the
+    /// correlative local search to turn B about it, in pixels, for both its searches
+    /// (`mapmerge::search::SearchConfig::overlap_pivot_px`; `inf` never; default: the
+    /// library's), to measure what it changes.
+    #[arg(long)]
+    search_overlap_pivot: Option<f64>,
     /// Override what the correlative local search subtracts per wall cell landing on known
     /// cells far from the other map's walls, for both its searches
     /// (`mapmerge::search::SearchConfig::free_penalty`; default: the library's).
@@ -759,6 +765,11 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
     if let Some(n) = args.search_points {
         for search in config.pair.searches_mut() {
             search.max_points = n;
+        }
+    }
+    if let Some(px) = args.search_overlap_pivot {
+        for search in config.pair.searches_mut() {
+            search.overlap_pivot_px = px;
         }
     }
     for refine in [&mut config.pair.refine, &mut config.pair.global_refine]
