@@ -416,6 +416,21 @@ fn fixture_floor(name: &str) -> Result<OccupancyGrid> {
         .with_context(|| format!("loading {}", yaml.display()))
 }
 
+/// A row of `suite`: two lidar robots with 10 % range noise exploring the floor
+/// `fixtures/maps/NAME` at the smallest overlap, 30 %.
+fn floor_at_30(suite: &'static str, name: &str) -> Result<Row> {
+    Ok(Row {
+        suite,
+        label: format!("{name} world, overlap 0.3, noise 10%/10%"),
+        config: case(
+            world(WorldKind::Grid(fixture_floor(name)?), 0),
+            vec![lidar(0.10), lidar(0.10)],
+            0.3,
+        ),
+        expect_decline: false,
+    })
+}
+
 fn rows(suites: &[String], size: usize, mapper: Mapper) -> Result<Vec<Row>> {
     let all = suites.iter().any(|s| s == "all");
     let want = |name: &str| all || suites.iter().any(|s| s == name);
@@ -550,36 +565,15 @@ fn rows(suites: &[String], size: usize, mapper: Mapper) -> Result<Vec<Row>> {
         });
     }
     if want("real") {
-        // A warehouse (the nav2 depot: shelf rows that repeat), two robots of one model at the
-        // issue's smallest overlap. Listed last, so that every other row keeps its cases.
-        let grid = fixture_floor("nav2_depot")?;
-        rows.push(Row {
-            suite: "real",
-            label: "nav2_depot world, overlap 0.3, noise 10%/10%".into(),
-            config: case(
-                world(WorldKind::Grid(grid), 0),
-                vec![lidar(0.10), lidar(0.10)],
-                0.3,
-            ),
-            expect_decline: false,
-        });
+        // A warehouse (the nav2 depot: shelf rows that repeat). Listed last, so that every
+        // other row keeps its cases.
+        rows.push(floor_at_30("real", "nav2_depot")?);
     }
     if want("large") {
-        // A large floor (the nav2 warehouse: 1006 x 1674 cells of 3 cm, long shelving rows),
-        // two robots of one model at the smallest overlap: maps about 1800 x 900 cells,
-        // where a tenth of a degree moves the far walls by a pixel or more. Its own suite,
-        // since each case takes seconds to simulate.
-        let grid = fixture_floor("nav2_warehouse")?;
-        rows.push(Row {
-            suite: "large",
-            label: "nav2_warehouse world, overlap 0.3, noise 10%/10%".into(),
-            config: case(
-                world(WorldKind::Grid(grid), 0),
-                vec![lidar(0.10), lidar(0.10)],
-                0.3,
-            ),
-            expect_decline: false,
-        });
+        // A large floor (the nav2 warehouse: 1006 x 1674 cells of 3 cm, long shelving rows):
+        // maps about 1800 x 900 cells, where a tenth of a degree moves the far walls by a pixel
+        // or more. Its own suite, since each case takes seconds to simulate.
+        rows.push(floor_at_30("large", "nav2_warehouse")?);
     }
     anyhow::ensure!(!rows.is_empty(), "no known suite in {suites:?}");
     if mapper != Mapper::Default {

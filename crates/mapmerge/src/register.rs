@@ -1250,7 +1250,7 @@ pub fn register(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::testmaps::{bare_room, room};
+    use crate::testmaps::{bare_room, room, room_with_wall_across};
     use grid_core::DVec2;
     use grid_core::metrics::{displacement_error, rotation_error_deg};
 
@@ -1544,12 +1544,7 @@ mod tests {
         // B saw an obstacle A's robot saw through: a line of wall cells across A's free space,
         // more than the wide tolerance from A's walls.
         let a = room();
-        let mut cluttered = room();
-        let w = cluttered.width();
-        for x in 20..100 {
-            cluttered.cells_mut()[22 * w + x] = 100;
-        }
-        let (b, truth) = turned(&cluttered);
+        let (b, truth) = turned(&room_with_wall_across(22));
         let with_bar = |bar: f64| {
             let mut config = pair_config(true);
             config.pair.verify.max_wall_contradiction = bar;

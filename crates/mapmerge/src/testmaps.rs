@@ -8,6 +8,17 @@ pub(crate) fn room() -> OccupancyGrid {
     grown_room(0)
 }
 
+/// [`room`] with a wall across it along row `y` (cells 20-99), as a robot that saw an obstacle
+/// the other robot's map shows as free space would map it.
+pub(crate) fn room_with_wall_across(y: usize) -> OccupancyGrid {
+    let mut grid = room();
+    let w = grid.width();
+    for x in 20..100 {
+        grid.cells_mut()[y * w + x] = 100;
+    }
+    grid
+}
+
 /// [`room`] with its outer walls moved `d` cells outwards (at most 2), as a range sensor's bias
 /// pushes walls seen from inside the room; the half wall and the pillar stay.
 pub(crate) fn grown_room(d: usize) -> OccupancyGrid {

@@ -1074,7 +1074,7 @@ pub fn verify_with_offsets(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::testmaps::{grown_room, room};
+    use crate::testmaps::{grown_room, room, room_with_wall_across};
     use grid_core::UNKNOWN;
 
     #[test]
@@ -1106,11 +1106,7 @@ mod tests {
     fn an_obstacle_one_robot_saw_contradicts_one_way() {
         // B saw a wall across A's room that A's robot saw through; A has nothing B contradicts.
         let a = room();
-        let mut cluttered = room();
-        let w = cluttered.width();
-        for x in 20..100 {
-            cluttered.cells_mut()[22 * w + x] = 100;
-        }
+        let cluttered = room_with_wall_across(22);
         let config = VerifyConfig::default();
         let (pa, pb) = (
             PreparedMap::new(&a, &config),
@@ -1120,10 +1116,7 @@ mod tests {
         assert!(v.wall_contradiction > 0.05, "{v:?}");
         assert_eq!(v.mutual_contradiction, 0.0);
         // Both ways, when each map has a wall the other saw through.
-        let mut other = room();
-        for x in 20..100 {
-            other.cells_mut()[60 * w + x] = 100;
-        }
+        let other = room_with_wall_across(60);
         let po = PreparedMap::new(&other, &config);
         let v = verify(&po, &pb, &Rigid2::IDENTITY, &config);
         assert!(v.mutual_contradiction > 0.05, "{v:?}");

@@ -453,22 +453,38 @@ fn a_warehouse_pair_whose_best_placement_is_a_quarter_turn_off_is_declined() {
     config.world.kind = WorldKind::Grid(depot);
     config.overlap = 0.3;
     let case = generate_case(&config, 18).unwrap();
-    let (r, error) = registered(&case, &RegisterConfig::default());
+    declined_for(&case, "the best placement fits imperfectly");
+    answered_far_off_without(&case, |verify| {
+        verify.trusted_wide_wall_lift = 0.0;
+        // The best would fail the crisp-walls bar too (lift 0.77, 12 % of walls in free space).
+        verify.crisp_wall_lift = 2.0;
+    });
+}
+
+/// `case`'s pair is declined with a reason that contains `why`.
+fn declined_for(case: &Case, why: &str) {
+    let (r, error) = registered(case, &RegisterConfig::default());
     assert!(
         r.reason
             .as_deref()
-            .is_some_and(|reason| reason.contains("the best placement fits imperfectly")),
+            .is_some_and(|reason| reason.contains(why)),
         "error {error:?}, reason {:?}",
         r.reason
     );
-    let mut without = RegisterConfig::default();
-    without.pair.verify.trusted_wide_wall_lift = 0.0;
-    // The best would fail the crisp-walls bar too (lift 0.77, 12 % of walls in free space).
-    without.pair.verify.crisp_wall_lift = 2.0;
-    let (_, error) = registered(&case, &without);
+}
+
+/// With the verification changed by `without`, `case`'s pair is answered more than 200 px off.
+fn answered_far_off_without(
+    case: &Case,
+    without: impl FnOnce(&mut mapmerge::verify::VerifyConfig),
+) {
+    let mut config = RegisterConfig::default();
+    without(&mut config.pair.verify);
+    let (r, error) = registered(case, &config);
     assert!(
         error.is_some_and(|e| e > 200.0),
-        "without the rule: {error:?}"
+        "without the rule: {error:?}, reason {:?}",
+        r.reason
     );
 }
 
@@ -505,20 +521,6 @@ fn a_warehouse_pair_matched_by_crisp_walls_a_quarter_turn_off_is_declined() {
         ..CaseConfig::default()
     };
     let case = generate_case(&config, 7_004_003).unwrap();
-    let (r, error) = registered(&case, &RegisterConfig::default());
-    assert!(
-        r.reason
-            .as_deref()
-            .is_some_and(|reason| reason.contains("lays walls on walls crisply")),
-        "error {error:?}, reason {:?}",
-        r.reason
-    );
-    let mut without = RegisterConfig::default();
-    without.pair.verify.crisp_wall_lift = 2.0;
-    let (r, error) = registered(&case, &without);
-    assert!(
-        error.is_some_and(|e| e > 200.0),
-        "without the rule: {error:?}, reason {:?}",
-        r.reason
-    );
+    declined_for(&case, "lays walls on walls crisply");
+    answered_far_off_without(&case, |verify| verify.crisp_wall_lift = 2.0);
 }
