@@ -443,11 +443,7 @@ fn a_pair_drawn_by_octomaps_mapper_is_registered() {
 /// declined rather than answered 300 px off.
 #[test]
 fn a_warehouse_pair_whose_best_placement_is_a_quarter_turn_off_is_declined() {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../fixtures/maps/nav2_depot/nav2_depot.yaml"
-    );
-    let depot = grid_core::io::load_map(path, &Default::default()).unwrap();
+    let depot = depot();
     let mut config = CaseConfig::paper();
     config.world.resolution = depot.resolution();
     config.world.kind = WorldKind::Grid(depot);
@@ -459,6 +455,15 @@ fn a_warehouse_pair_whose_best_placement_is_a_quarter_turn_off_is_declined() {
         // The best would fail the crisp-walls bar too (lift 0.77, 12 % of walls in free space).
         verify.crisp_wall_lift = 2.0;
     });
+}
+
+/// The nav2 depot of `fixtures/maps`, a warehouse whose shelf rows repeat.
+fn depot() -> OccupancyGrid {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../fixtures/maps/nav2_depot/nav2_depot.yaml"
+    );
+    grid_core::io::load_map(path, &Default::default()).unwrap()
 }
 
 /// `case`'s pair is declined with a reason that contains `why`.
@@ -497,11 +502,7 @@ fn answered_far_off_without(
 /// declined rather than answered 310 px off.
 #[test]
 fn a_warehouse_pair_matched_by_crisp_walls_a_quarter_turn_off_is_declined() {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../fixtures/maps/nav2_depot/nav2_depot.yaml"
-    );
-    let depot = grid_core::io::load_map(path, &Default::default()).unwrap();
+    let depot = depot();
     let config = CaseConfig {
         world: WorldConfig {
             kind: WorldKind::Grid(depot),
