@@ -188,6 +188,31 @@ pub struct EvalArgs {
     /// what `mapmerge::SpectrumRotation` adds).
     #[arg(long)]
     no_spectrum_rotation: bool,
+    /// Keep the best answer's angle from ICP instead of the maps' dominant wall directions
+    /// where its agreeing walls spread far (to measure what `mapmerge::ManhattanRotation`
+    /// adds).
+    #[arg(long)]
+    no_manhattan_rotation: bool,
+    /// Override the contrast of each map's dominant wall direction the Manhattan angle needs
+    /// (`mapmerge::ManhattanRotation::min_contrast`; default: the library's), for calibration
+    /// experiments.
+    #[arg(long, value_parser = non_negative)]
+    manhattan_min_contrast: Option<f64>,
+    /// Override how far (degrees) the Manhattan angle may lie from the answer's
+    /// (`mapmerge::ManhattanRotation::max_delta_deg`; default: the library's), for calibration
+    /// experiments.
+    #[arg(long, value_parser = angle_window)]
+    manhattan_max_delta: Option<f64>,
+    /// Override the spread of the agreeing walls (pixels) from which the Manhattan angle is
+    /// taken (`mapmerge::ManhattanRotation::min_lever_px`; default: the library's), for
+    /// calibration experiments.
+    #[arg(long, value_parser = non_negative)]
+    manhattan_min_lever: Option<f64>,
+    /// Override how far B's known cells must reach, in spreads of the agreeing walls, for the
+    /// Manhattan angle to be taken (`mapmerge::ManhattanRotation::min_reach_ratio`; default:
+    /// the library's), for calibration experiments.
+    #[arg(long, value_parser = non_negative)]
+    manhattan_min_reach: Option<f64>,
     /// Override how far (degrees) the spectrum angle may lie from the answer's (see
     /// `mapmerge::SpectrumRotation::max_delta_deg`; default: the library's), for calibration
     /// experiments.
@@ -806,6 +831,15 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
     }
     if args.no_spectrum_rotation {
         config.pair.spectrum_rotation = None;
+    }
+    if let Some(mr) = &mut config.pair.manhattan_rotation {
+        mr.min_contrast = args.manhattan_min_contrast.unwrap_or(mr.min_contrast);
+        mr.max_delta_deg = args.manhattan_max_delta.unwrap_or(mr.max_delta_deg);
+        mr.min_lever_px = args.manhattan_min_lever.unwrap_or(mr.min_lever_px);
+        mr.min_reach_ratio = args.manhattan_min_reach.unwrap_or(mr.min_reach_ratio);
+    }
+    if args.no_manhattan_rotation {
+        config.pair.manhattan_rotation = None;
     }
     if let Some([free, occupied, unknown]) = args.sift_mapping {
         let m = &mut config.sift.mapping;

@@ -696,6 +696,98 @@ pub fn spectrum_rotation_near(
         .map(|d| theta + d)
 }
 
+/// A map's dominant wall direction modulo a quarter turn ([`manhattan_direction`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ManhattanDirection {
+    /// Normal angle of the dominant wall family, radians in `[0, pi/2)`; the walls at right
+    /// angles to it count with it.
+    pub angle: f64,
+    /// How much sharper the walls' projections are along that direction and its right angle
+    /// than along the directions 45 degrees off: the Hough spectrum (sum of squared counts over
+    /// 1 px distance bins) of both there over both here. About 1 for walls without a dominant
+    /// direction (rubble, round obstacles); a floor of straight walls at right angles scores
+    /// several times that.
+    pub contrast: f64,
+}
+
+/// Hough spectrum value of centred `points` at normal angle `phi`: the sum of squared counts
+/// over 1 px distance bins, each point's vote split linearly between its two bins so that
+/// the value is continuous in `phi` (a search for its maximum can then go below a bin's
+/// angle).
+fn projection_sharpness(points: &[DVec2], phi: f64, rmax: f64, acc: &mut Vec<f64>) -> f64 {
+    let (s, c) = phi.sin_cos();
+    acc.clear();
+    acc.resize(2 * rmax.ceil() as usize + 3, 0.0);
+    for p in points {
+        let r = p.x * c + p.y * s + rmax;
+        let f = r.floor();
+        let w = r - f;
+        let i = f as usize;
+        acc[i] += 1.0 - w;
+        acc[i + 1] += w;
+    }
+    acc.iter().map(|v| v * v).sum()
+}
+
+/// The dominant direction of a set of wall points modulo a quarter turn, where the Hough
+/// spectrum of the walls and of the walls at right angles to them is sharpest: on a floor
+/// built at right angles (a warehouse, most buildings: the "Manhattan world" of indoor
+/// mapping) every straight wall of the map votes for it, wherever it is, so the angle does not
+/// rest on the short lever of a small overlap. A coarse scan every half degree on at most
+/// [`MANHATTAN_COARSE_POINTS`] of the points (evenly strided), then a golden-section search of
+/// the continuous spectrum of all of them within a step of the best; `None` for fewer than 10
+/// points.
+pub fn manhattan_direction(points: &[DVec2]) -> Option<ManhattanDirection> {
+    if points.len() < 10 {
+        return None;
+    }
+    let c = points.iter().copied().sum::<DVec2>() / points.len() as f64;
+    let centred: Vec<DVec2> = points.iter().map(|p| *p - c).collect();
+    let coarse = strided(&centred, MANHATTAN_COARSE_POINTS);
+    let rmax = centred.iter().map(|p| p.length()).fold(0.0, f64::max) + 1.0;
+    let mut acc = Vec::new();
+    let mut both = |points: &[DVec2], phi: f64| {
+        projection_sharpness(points, phi, rmax, &mut acc)
+            + projection_sharpness(points, phi + PI / 2.0, rmax, &mut acc)
+    };
+    let step = 0.5f64.to_radians();
+    let steps = (PI / 2.0 / step).round() as usize;
+    let (mut best, mut best_value) = (0.0, f64::MIN);
+    for k in 0..steps {
+        let phi = k as f64 * step;
+        let v = both(&coarse, phi);
+        if v > best_value {
+            (best, best_value) = (phi, v);
+        }
+    }
+    // Golden section on all the points: the bracket shrinks by 0.618 an evaluation, to well
+    // under a thousandth of a degree.
+    let g = (5f64.sqrt() - 1.0) / 2.0;
+    let (mut lo, mut hi) = (best - step, best + step);
+    let (mut x1, mut x2) = (hi - g * (hi - lo), lo + g * (hi - lo));
+    let (mut f1, mut f2) = (both(&centred, x1), both(&centred, x2));
+    for _ in 0..30 {
+        if f1 < f2 {
+            lo = x1;
+            (x1, f1) = (x2, f2);
+            x2 = lo + g * (hi - lo);
+            f2 = both(&centred, x2);
+        } else {
+            hi = x2;
+            (x2, f2) = (x1, f1);
+            x1 = hi - g * (hi - lo);
+            f1 = both(&centred, x1);
+        }
+    }
+    let angle = (0.5 * (lo + hi)).rem_euclid(PI / 2.0);
+    let contrast = both(&centred, angle) / both(&centred, angle + PI / 4.0).max(1e-12);
+    Some(ManhattanDirection { angle, contrast })
+}
+
+/// Points [`manhattan_direction`]'s coarse scan takes at most: on the warehouse pairs of
+/// `cargo xtask eval --suites large --seed 7` 3000 points found the same peak as 20 000.
+pub const MANHATTAN_COARSE_POINTS: usize = 3000;
+
 /// Append global-search hypotheses (B→A, pixel convention) to `out`.
 pub fn global_hypotheses(
     a: &PreparedMap,
@@ -1294,5 +1386,62 @@ mod tests {
             "{}",
             best.to_degrees()
         );
+    }
+
+    /// Points every half pixel along the outlines of `rects` (centre, half sizes), all turned
+    /// by `angle` about the origin.
+    fn outlines(rects: &[(DVec2, DVec2)], angle: f64) -> Vec<DVec2> {
+        let turn = DVec2::from_angle(angle);
+        let mut points = Vec::new();
+        for &(c, h) in rects {
+            let corners = [
+                (-1.0, -1.0),
+                (1.0, -1.0),
+                (1.0, 1.0),
+                (-1.0, 1.0),
+                (-1.0, -1.0),
+            ]
+            .map(|(x, y)| c + h * DVec2::new(x, y));
+            for w in corners.windows(2) {
+                let n = ((w[1] - w[0]).length() * 2.0) as usize;
+                points.extend((0..n).map(|k| turn.rotate(w[0].lerp(w[1], k as f64 / n as f64))));
+            }
+        }
+        points
+    }
+
+    #[test]
+    fn the_dominant_direction_of_walls_at_right_angles_is_found_to_a_hundredth_of_a_degree() {
+        let rects = [
+            (DVec2::new(0.0, 0.0), DVec2::new(300.0, 200.0)),
+            (DVec2::new(-120.0, 40.0), DVec2::new(60.0, 15.0)),
+            (DVec2::new(150.0, -90.0), DVec2::new(20.0, 80.0)),
+        ];
+        for deg in [0.0f64, 7.3, 23.4, 44.6, 61.05, 89.9, 133.3] {
+            let d = manhattan_direction(&outlines(&rects, deg.to_radians())).unwrap();
+            let expected = deg.to_radians().rem_euclid(PI / 2.0);
+            let err = (d.angle - expected + PI / 4.0).rem_euclid(PI / 2.0) - PI / 4.0;
+            assert!(
+                err.to_degrees().abs() < 0.01,
+                "{deg}: {}",
+                d.angle.to_degrees()
+            );
+            assert!(d.contrast > 3.0, "{deg}: contrast {}", d.contrast);
+        }
+    }
+
+    #[test]
+    fn walls_without_a_dominant_direction_have_no_contrast() {
+        // Rings of radius 20 to 200 px: every direction alike.
+        let points: Vec<DVec2> = (1..=10)
+            .flat_map(|r| {
+                let r = 20.0 * r as f64;
+                let n = (r * 4.0 * PI) as usize;
+                (0..n).map(move |k| DVec2::from_angle(2.0 * PI * k as f64 / n as f64) * r)
+            })
+            .collect();
+        let d = manhattan_direction(&points).unwrap();
+        assert!(d.contrast < 1.2, "contrast {}", d.contrast);
+        assert_eq!(manhattan_direction(&points[..9]), None);
     }
 }

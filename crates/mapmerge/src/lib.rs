@@ -17,6 +17,7 @@ pub mod verify;
 mod testmaps;
 
 pub use register::{
-    Candidate, KindTotals, Method, Origin, PairConfig, PolishConfig, RegisterConfig, Registration,
-    SpectrumRotation, Timings, framed, refine_and_score, register, register_with,
+    Candidate, KindTotals, ManhattanRotation, Method, Origin, PairConfig, PolishConfig,
+    RegisterConfig, Registration, SpectrumRotation, Timings, framed, refine_and_score, register,
+    register_with,
 };

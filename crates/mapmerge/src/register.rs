@@ -11,13 +11,14 @@ use sift_desc::{SiftConfig, SiftCorrespondences};
 
 use crate::ascent::{AscentConfig, ascend, wall_thickness};
 use crate::global::{
-    GlobalConfig, SweepConfig, global_hypotheses, spectrum_rotation_near, sweep_placements, twins,
+    GlobalConfig, SweepConfig, global_hypotheses, manhattan_direction, spectrum_rotation_near,
+    sweep_placements, twins,
 };
 use crate::refine::{RefineConfig, refine_with_bias};
 use crate::search::{SearchConfig, local_search};
 use crate::verify::{
-    PreparedMap, StandOut, Verification, VerifyConfig, agreeing_wall_spread_px, verify,
-    verify_with_offsets, wall_residual_px,
+    PreparedMap, StandOut, Verification, VerifyConfig, agreeing_wall_spread_px, reach_over_spread,
+    strided, verify, verify_with_offsets, wall_residual_px,
 };
 
 /// Everything that tunes [`register_with`], with documented defaults.
@@ -93,6 +94,10 @@ pub struct PairConfig {
     /// translation refined at that angle, unless the polish applies; `None` disables it.
     /// Default: on, [`SpectrumRotation::default`].
     pub spectrum_rotation: Option<SpectrumRotation>,
+    /// The best candidate's angle taken from both maps' dominant wall directions when its
+    /// agreeing walls spread far, then its translation refined at that angle, unless the
+    /// polish applies; `None` disables it. Default: on, [`ManhattanRotation::default`].
+    pub manhattan_rotation: Option<ManhattanRotation>,
     /// Each map is registered on its own frame: the bounding box of its known cells grown by
     /// this many cells of unknown on every side, cut out of the map or padded with unknown
     /// where the map is smaller ([`framed`]). The answer is then the same whatever unknown
@@ -200,6 +205,82 @@ impl Default for SpectrumRotation {
     }
 }
 
+/// The best candidate's angle taken from both maps' dominant wall directions, modulo a quarter
+/// turn ([`crate::global::manhattan_direction`]), then its translation refined at that angle:
+/// for answers whose agreeing walls spread far (where [`SpectrumRotation`] leaves ICP's angle
+/// alone) on floors built at right angles.
+///
+/// On a large map a small overlap pins the angle poorly even with a long lever: a noisy range
+/// sensor pushes walls behind the obstacle faces by an amount that grows with range, so a wall
+/// seen at a slant comes out tilted, each map's its own way, and the pose ICP and the
+/// verification score prefer lies a few tenths of a degree off; on B's far cells that is
+/// several pixels. Every straight wall of a map, in the overlap or not, tells its dominant
+/// direction, and the difference of the two maps' directions is the rotation modulo a quarter
+/// turn; it is taken only near the answer's own angle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ManhattanRotation {
+    /// Wall cells per map (evenly strided). Default 20000.
+    pub max_points: usize,
+    /// Only a direction difference this close to the answer's angle (degrees, modulo a
+    /// quarter turn) is taken. Default 1.
+    pub max_delta_deg: f64,
+    /// Each map's [`crate::global::ManhattanDirection::contrast`] must reach this. Default 1.5.
+    pub min_contrast: f64,
+    /// Taken only when the walls that agree under the answer spread at least this far
+    /// ([`crate::verify::agreeing_wall_spread_px`]); below it [`SpectrumRotation`] applies.
+    /// Default 140.
+    pub min_lever_px: f64,
+    /// Taken only when B's known cells reach at least this many times that spread from the
+    /// agreeing walls' centre ([`crate::verify::reach_over_spread`]): where the overlap takes
+    /// up most of B, ICP's angle on the shared walls is as good as B's far cells need.
+    /// Default 1.2: the answers the angle moved in the 50 % and 70 % rows of `cargo xtask eval
+    /// --suites overlap --seed 7` lie at 0.93-1.10 (on the disaster world, whose walls have
+    /// no dominant direction beyond the arena's border, it turned four of them 0.3-0.6 degrees
+    /// off, though none past 3 px), the intel_lab pairs of `--suites real --seed 7` at
+    /// 1.18-1.96 and the warehouse pairs at 1.3-2.8.
+    pub min_reach_ratio: f64,
+    /// Taken only when the answer's walls lie on average at least this far from the other
+    /// map's ([`crate::verify::wall_residual_px`]): crisp walls pin the angle better.
+    /// Default 0.3, as [`SpectrumRotation::min_wall_residual_px`].
+    pub min_wall_residual_px: f64,
+}
+
+impl Default for ManhattanRotation {
+    fn default() -> Self {
+        Self {
+            max_points: 20000,
+            max_delta_deg: 1.0,
+            min_contrast: 1.5,
+            min_lever_px: 140.0,
+            min_reach_ratio: 1.2,
+            min_wall_residual_px: 0.3,
+        }
+    }
+}
+
+/// The rotation of B onto A nearest to `theta` that the maps' dominant wall directions give
+/// (see [`ManhattanRotation`]), if it lies within `config.max_delta_deg` of it and both maps
+/// have a clear dominant direction.
+fn manhattan_rotation_near(
+    a: &PreparedMap,
+    b: &PreparedMap,
+    theta: f64,
+    config: &ManhattanRotation,
+) -> Option<f64> {
+    let (da, db) = rayon::join(
+        || manhattan_direction(&strided(&a.wall_samples, config.max_points)),
+        || manhattan_direction(&strided(&b.wall_samples, config.max_points)),
+    );
+    let (da, db) = (da?, db?);
+    if da.contrast.min(db.contrast) < config.min_contrast {
+        return None;
+    }
+    let quarter = std::f64::consts::FRAC_PI_2;
+    let d = (da.angle - db.angle - theta).rem_euclid(quarter);
+    let d = if d > quarter / 2.0 { d - quarter } else { d };
+    (d.abs() <= config.max_delta_deg.to_radians()).then_some(theta + d)
+}
+
 /// `b_to_a` turned to angle `theta` about the centre of B's walls that it puts on known cells
 /// of A (so that the shared part stays in place); `None` if none lands there.
 fn turned_about_overlap(
@@ -304,6 +385,7 @@ impl Default for PairConfig {
             offsets_in_verification: true,
             polish: Some(PolishConfig::default()),
             spectrum_rotation: Some(SpectrumRotation::default()),
+            manhattan_rotation: Some(ManhattanRotation::default()),
             frame_margin: Some(64),
             refine_placements_as_proposed: false,
             refined_placements: Some(8),
@@ -1060,6 +1142,29 @@ fn register_as_given(
                 v.wide_wall_lift >= r.min_wide_wall_lift && v.wall_density >= r.min_wall_density
             });
         if v.accepted(&config.verify) || still_out {
+            (best.transform, best.verification) = (t.normalized(), v);
+        }
+    }
+    // The best candidate's angle from the maps' dominant wall directions (see
+    // `ManhattanRotation`).
+    if let Some(mr) = &config.manhattan_rotation
+        && let Some(best) = candidates.first_mut().filter(|c| c.accepted && !clean(c))
+        && wall_residual_px(&pa, &pb, &best.transform, 3.0, mr.max_points)
+            .is_some_and(|r| r >= mr.min_wall_residual_px)
+        && agreeing_wall_spread_px(&pa, &pb, &best.transform, 3.0)
+            .is_some_and(|spread| spread >= mr.min_lever_px)
+        && reach_over_spread(&pa, &pb, &best.transform, 3.0)
+            .is_some_and(|ratio| ratio >= mr.min_reach_ratio)
+        && let Some(theta) = manhattan_rotation_near(&pa, &pb, best.transform.theta, mr)
+        && let Some(start) = turned_about_overlap(&pa, &pb, &best.transform, theta)
+    {
+        let locked = RefineConfig {
+            lock_rotation: true,
+            ..config.refine
+        };
+        let (t, offsets) = refine_with_bias(&pa, &pb, &start, &locked);
+        let v = verify_with_offsets(&pa, &pb, &t, offsets, &config.verify);
+        if v.accepted(&config.verify) {
             (best.transform, best.verification) = (t.normalized(), v);
         }
     }

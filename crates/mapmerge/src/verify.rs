@@ -934,6 +934,42 @@ pub fn agreeing_wall_spread_px(
     b_to_a: &Rigid2,
     within_px: f32,
 ) -> Option<f64> {
+    agreeing_walls(a, b, b_to_a, within_px).map(|(_, spread)| spread)
+}
+
+/// How far B's known cells reach beyond the walls that agree under `b_to_a`: their mean
+/// distance (the sampled known cells, in A's frame) from the centre of B's wall cells that
+/// land within `within_px` of a wall of A, over those walls' spread
+/// ([`agreeing_wall_spread_px`]). An error in the angle moves each of B's cells by the angle
+/// times its distance from that centre, while the walls that pin the angle span the spread:
+/// about 1 where the overlap takes up most of B, 1.3-2.8 for a third of a large floor
+/// (docs/EVALUATION.md, "A large floor's angle from its walls at right angles"). `None` when
+/// fewer than 20 wall cells land that close.
+pub fn reach_over_spread(
+    a: &PreparedMap,
+    b: &PreparedMap,
+    b_to_a: &Rigid2,
+    within_px: f32,
+) -> Option<f64> {
+    let (centre, spread) = agreeing_walls(a, b, b_to_a, within_px)?;
+    let n = b.known_samples.len().max(1) as f64;
+    let reach = b
+        .known_samples
+        .iter()
+        .map(|&p| (b_to_a.apply(p) - centre).length())
+        .sum::<f64>()
+        / n;
+    Some(reach / spread.max(1e-9))
+}
+
+/// The centre and the radius of gyration of B's wall cells that land within `within_px` of a
+/// wall of A under `b_to_a`; `None` when fewer than 20 do.
+fn agreeing_walls(
+    a: &PreparedMap,
+    b: &PreparedMap,
+    b_to_a: &Rigid2,
+    within_px: f32,
+) -> Option<(DVec2, f64)> {
     let near = near_walls(b, a, b_to_a, within_px, usize::MAX);
     if near.len() < 20 {
         return None;
@@ -944,7 +980,7 @@ pub fn agreeing_wall_spread_px(
         .iter()
         .map(|&(q, _)| (q - centre).length_squared())
         .sum::<f64>();
-    Some((spread / n).sqrt())
+    Some((centre, (spread / n).sqrt()))
 }
 
 /// `from`'s wall cells (at most `max_points`, evenly strided) mapped by `t` into `onto`, with
@@ -1075,7 +1111,7 @@ pub fn verify_with_offsets(
 mod tests {
     use super::*;
     use crate::testmaps::{grown_room, room, room_with_wall_across};
-    use grid_core::UNKNOWN;
+    use grid_core::{Pose2, UNKNOWN};
 
     #[test]
     fn crisp_walls_lower_the_contradiction_bar() {
@@ -1228,6 +1264,53 @@ mod tests {
         // Placed where no wall of B comes near a wall of A: no lever.
         let far = Rigid2::new(0.0, 500.0, 0.0);
         assert_eq!(agreeing_wall_spread_px(&pa, &pa, &far, 3.0), None);
+    }
+
+    #[test]
+    fn b_reaches_beyond_the_agreeing_walls_by_the_mean_distance_of_its_known_cells() {
+        let vc = VerifyConfig::default();
+        let a = room();
+        let pa = PreparedMap::new(&a, &vc);
+        // Onto itself every wall agrees; the mean distance of the known cells from the walls'
+        // centre, computed directly, over the walls' spread.
+        let own = reach_over_spread(&pa, &pa, &Rigid2::default(), 3.0).unwrap();
+        let c = pa.wall_samples.iter().copied().sum::<DVec2>() / pa.wall_samples.len() as f64;
+        let mean = pa
+            .known_samples
+            .iter()
+            .map(|p| (*p - c).length())
+            .sum::<f64>()
+            / pa.known_samples.len() as f64;
+        let spread = agreeing_wall_spread_px(&pa, &pa, &Rigid2::default(), 3.0).unwrap();
+        assert!(
+            (own - mean / spread).abs() < 1e-9,
+            "{own} against {}",
+            mean / spread
+        );
+        // A room's floor lies nearer its centre than its walls do.
+        assert!((0.5..1.0).contains(&own), "{own}");
+        // B: the same room, and a corridor 300 cells long out of its right wall that A never
+        // saw. Its walls land on A's unknown cells and do not add to the lever; its floor
+        // reaches far beyond it.
+        let (w, h) = (420, 100);
+        let mut cells = vec![UNKNOWN; w * h];
+        for y in 0..h {
+            cells[y * w..y * w + a.width()]
+                .copy_from_slice(&a.cells()[y * a.width()..][..a.width()]);
+        }
+        for y in 45..=55 {
+            for x in 109..=409 {
+                let wall = (y == 45 || y == 55 || x == 409) && x > 109;
+                cells[y * w + x] = if wall { 100 } else { 0 };
+            }
+        }
+        let b = OccupancyGrid::from_cells(w, h, 0.05, Pose2::default(), cells).unwrap();
+        let pb = PreparedMap::new(&b, &vc);
+        let far = reach_over_spread(&pa, &pb, &Rigid2::default(), 3.0).unwrap();
+        assert!(far > 1.5 * own, "{far} against {own}");
+        // No wall of B near a wall of A: no lever, no ratio.
+        let away = Rigid2::new(0.0, 500.0, 0.0);
+        assert_eq!(reach_over_spread(&pa, &pb, &away, 3.0), None);
     }
 
     #[test]
