@@ -535,8 +535,8 @@ fn floor_case(floor: OccupancyGrid, seed: u64) -> Case {
 /// Case 7000005 of `cargo xtask eval --suites large --seed 7`: two robots in the nav2
 /// warehouse (1006 x 1674 cells), maps about 1500 x 1600 cells overlapping by 30 %. ICP and
 /// the verification score both settle on an angle 0.49 degrees off (4.7 px on average over
-/// B's cells): the overlap's walls, tilted by range noise, do not pin it over B's far cells.
-/// The two maps' dominant wall directions do (`mapmerge::ManhattanRotation`).
+/// B's cells): the overlap's walls, tilted in each map its own way, do not pin it over B's
+/// far cells. The two maps' dominant wall directions do (`mapmerge::ManhattanRotation`).
 #[test]
 fn a_large_warehouse_pair_takes_its_angle_from_the_walls_at_right_angles() {
     let case = floor_case(
