@@ -1174,10 +1174,9 @@ fn register_as_given(
             .is_some_and(|ratio| ratio >= mr.min_reach_ratio)
         && let Some(theta) = manhattan_rotation_near(&pa, &pb, best.transform.theta, mr)
         && let Some((t, v)) = at_angle(&pa, &pb, &best.transform, theta, config)
+        && v.accepted(&config.verify)
     {
-        if v.accepted(&config.verify) {
-            (best.transform, best.verification) = (t.normalized(), v);
-        }
+        (best.transform, best.verification) = (t.normalized(), v);
     }
     // The answer climbs the verification score (see `crate::ascent`), unless it was polished
     // (walls that agree almost everywhere: ICP's pose is then sub-pixel, the score's counts at
