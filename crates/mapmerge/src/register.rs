@@ -17,7 +17,7 @@ use crate::global::{
 use crate::refine::{RefineConfig, refine_with_bias};
 use crate::search::{SearchConfig, local_search};
 use crate::verify::{
-    PreparedMap, StandOut, Verification, VerifyConfig, agreeing_wall_spread_px, reach_over_spread,
+    PreparedMap, StandOut, Verification, VerifyConfig, agreeing_lever, agreeing_wall_spread_px,
     strided, verify, verify_with_offsets, wall_residual_px,
 };
 
@@ -235,7 +235,7 @@ pub struct ManhattanRotation {
     /// Default 140.
     pub min_lever_px: f64,
     /// Taken only when B's known cells reach at least this many times that spread from the
-    /// agreeing walls' centre ([`crate::verify::reach_over_spread`]): where the overlap takes
+    /// agreeing walls' centre ([`crate::verify::agreeing_lever`]): where the overlap takes
     /// up most of B, ICP's angle on the shared walls is as good as B's far cells need.
     /// Default 1.2: the answers the angle moved in the 50 % and 70 % rows of `cargo xtask eval
     /// --suites overlap --seed 7` lie at 0.93-1.10 (on the disaster world, whose walls have
@@ -1171,10 +1171,8 @@ fn register_as_given(
         && let Some(best) = candidates.first_mut().filter(|c| c.accepted && !clean(c))
         && wall_residual_px(&pa, &pb, &best.transform, 3.0, mr.max_points)
             .is_some_and(|r| r >= mr.min_wall_residual_px)
-        && agreeing_wall_spread_px(&pa, &pb, &best.transform, 3.0)
-            .is_some_and(|spread| spread >= mr.min_lever_px)
-        && reach_over_spread(&pa, &pb, &best.transform, 3.0)
-            .is_some_and(|ratio| ratio >= mr.min_reach_ratio)
+        && agreeing_lever(&pa, &pb, &best.transform, 3.0)
+            .is_some_and(|(spread, ratio)| spread >= mr.min_lever_px && ratio >= mr.min_reach_ratio)
         && let Some(theta) = manhattan_rotation_near(&pa, &pb, best.transform.theta, mr)
         && let Some((t, v)) = at_angle(&pa, &pb, &best.transform, theta, config)
         && v.accepted(&config.verify)

@@ -937,20 +937,20 @@ pub fn agreeing_wall_spread_px(
     agreeing_walls(a, b, b_to_a, within_px).map(|(_, spread)| spread)
 }
 
-/// How far B's known cells reach beyond the walls that agree under `b_to_a`: their mean
-/// distance (the sampled known cells, in A's frame) from the centre of B's wall cells that
-/// land within `within_px` of a wall of A, over those walls' spread
-/// ([`agreeing_wall_spread_px`]). An error in the angle moves each of B's cells by the angle
-/// times its distance from that centre, while the walls that pin the angle span the spread:
-/// about 1 where the overlap takes up most of B, 1.3-2.8 for a third of a large floor
-/// (docs/EVALUATION.md, "A large floor's angle from its walls at right angles"). `None` when
-/// fewer than 20 wall cells land that close.
-pub fn reach_over_spread(
+/// The lever of the walls that agree under `b_to_a`, and how far B's known cells reach beyond
+/// it: the spread of those walls ([`agreeing_wall_spread_px`]), and the mean distance of B's
+/// known cells (the sampled ones, in A's frame) from the centre of B's wall cells that land
+/// within `within_px` of a wall of A, over that spread. An error in the angle moves each of
+/// B's cells by the angle times its distance from that centre, while the walls that pin the
+/// angle span the spread: the ratio is about 1 where the overlap takes up most of B, 1.3-2.8
+/// for a third of a large floor (docs/EVALUATION.md, "A large floor's angle from its walls at
+/// right angles"). `None` when fewer than 20 wall cells land that close.
+pub fn agreeing_lever(
     a: &PreparedMap,
     b: &PreparedMap,
     b_to_a: &Rigid2,
     within_px: f32,
-) -> Option<f64> {
+) -> Option<(f64, f64)> {
     let (centre, spread) = agreeing_walls(a, b, b_to_a, within_px)?;
     let n = b.known_samples.len().max(1) as f64;
     let reach = b
@@ -959,7 +959,7 @@ pub fn reach_over_spread(
         .map(|&p| (b_to_a.apply(p) - centre).length())
         .sum::<f64>()
         / n;
-    Some(reach / spread.max(1e-9))
+    Some((spread, reach / spread.max(1e-9)))
 }
 
 /// The centre and the radius of gyration of B's wall cells that land within `within_px` of a
@@ -1273,7 +1273,7 @@ mod tests {
         let pa = PreparedMap::new(&a, &vc);
         // Onto itself every wall agrees; the mean distance of the known cells from the walls'
         // centre, computed directly, over the walls' spread.
-        let own = reach_over_spread(&pa, &pa, &Rigid2::default(), 3.0).unwrap();
+        let (_, own) = agreeing_lever(&pa, &pa, &Rigid2::default(), 3.0).unwrap();
         let c = pa.wall_samples.iter().copied().sum::<DVec2>() / pa.wall_samples.len() as f64;
         let mean = pa
             .known_samples
@@ -1306,11 +1306,11 @@ mod tests {
         }
         let b = OccupancyGrid::from_cells(w, h, 0.05, Pose2::default(), cells).unwrap();
         let pb = PreparedMap::new(&b, &vc);
-        let far = reach_over_spread(&pa, &pb, &Rigid2::default(), 3.0).unwrap();
+        let (_, far) = agreeing_lever(&pa, &pb, &Rigid2::default(), 3.0).unwrap();
         assert!(far > 1.5 * own, "{far} against {own}");
         // No wall of B near a wall of A: no lever, no ratio.
         let away = Rigid2::new(0.0, 500.0, 0.0);
-        assert_eq!(reach_over_spread(&pa, &pb, &away, 3.0), None);
+        assert_eq!(agreeing_lever(&pa, &pb, &away, 3.0), None);
     }
 
     #[test]
