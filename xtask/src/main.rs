@@ -3,6 +3,7 @@
 
 use clap::{Parser, Subcommand};
 
+mod compare;
 mod eval;
 mod r#gen;
 mod picture;
@@ -22,11 +23,14 @@ enum Command {
     Gen(Box<r#gen::Args>),
     /// Measure registration accuracy, decline rate and time on regenerable simulated suites.
     Eval(Box<eval::EvalArgs>),
+    /// Compare two runs of `eval --out`, case by case: what changed.
+    Compare(compare::Args),
 }
 
 fn main() -> anyhow::Result<()> {
     match Cli::parse().command {
         Command::Gen(args) => r#gen::run(*args),
         Command::Eval(args) => eval::run(*args),
+        Command::Compare(args) => compare::run(args),
     }
 }
