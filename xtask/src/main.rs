@@ -7,6 +7,7 @@ mod compare;
 mod eval;
 mod r#gen;
 mod picture;
+mod regress;
 
 /// mapmerge project tasks.
 #[derive(Parser)]
@@ -25,6 +26,8 @@ enum Command {
     Eval(Box<eval::EvalArgs>),
     /// Compare two runs of `eval --out`, case by case: what changed.
     Compare(compare::Args),
+    /// Run the regression batch of eval sets into a directory (for `compare`).
+    Regress(regress::Args),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -32,5 +35,6 @@ fn main() -> anyhow::Result<()> {
         Command::Gen(args) => r#gen::run(*args),
         Command::Eval(args) => eval::run(*args),
         Command::Compare(args) => compare::run(args),
+        Command::Regress(args) => regress::run(args),
     }
 }
