@@ -51,11 +51,11 @@ pub fn run(args: Args) -> Result<()> {
 /// What a case came to.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Outcome {
-    /// Accepted and a success (for a pair that must be declined, a success is a decline).
+    /// Accepted and a success (within 3 px).
     Registered,
-    /// Accepted, not a success.
+    /// Accepted, not a success: more than 3 px off, or a pair that must be declined.
     Off,
-    /// Not accepted.
+    /// Not accepted (for a pair that must be declined, the success).
     Declined,
     /// The case did not generate.
     Failed,
