@@ -34,14 +34,11 @@ pub struct Args {
     /// The run after the change.
     after: PathBuf,
     /// List registered cases whose displacement error moved by more than this (pixels).
-    #[arg(long, default_value_t = 0.5, value_name = "PX")]
+    #[arg(long, default_value_t = 0.5, value_name = "PX", value_parser = crate::eval::non_negative)]
     moved: f64,
 }
 
 pub fn run(args: Args) -> Result<()> {
-    if !(args.moved.is_finite() && args.moved >= 0.0) {
-        bail!("--moved must be a finite number of pixels, 0 or more");
-    }
     let before = load(&args.before)?;
     let after = load(&args.after)?;
     print!("{}", compare(&before, &after, args.moved));

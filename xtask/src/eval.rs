@@ -353,7 +353,7 @@ fn frame_margin(s: &str) -> Result<FrameMargin, String> {
 }
 
 /// A finite number of pixels, 0 or more (`--spectrum-min-residual`, `--spectrum-max-lever`).
-fn non_negative(s: &str) -> Result<f64, String> {
+pub(crate) fn non_negative(s: &str) -> Result<f64, String> {
     let px: f64 = s.trim().parse().map_err(|e| format!("{s:?}: {e}"))?;
     if px.is_finite() && px >= 0.0 {
         Ok(px)
