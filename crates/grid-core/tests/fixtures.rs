@@ -122,6 +122,17 @@ const EXPECTED: &[Expected] = &[
         occupied: 23346 + 276,
         unknown: 895788,
     },
+    // 205:303940, 254:150467, 0:10668.
+    Expected {
+        name: "uos_avz",
+        width: 975,
+        height: 477,
+        resolution: 0.05,
+        origin: [0.0, 0.0, 0.0],
+        free: 150467,
+        occupied: 10668,
+        unknown: 303940,
+    },
     // Non-standard encoding, thresholds occ 0.2 / free 0.05 from its YAML:
     // free: p = (255 - v) / 255 < 0.05 ⟺ v > 242.25 ⟺ v >= 243;
     // occupied: p > 0.2 ⟺ 255 - v > 51 ⟺ v < 204 (v = 204 is p = 0.2 exactly: unknown);

@@ -153,6 +153,17 @@ fn info_json_on_every_fixture() {
             23346 + 276,
             895788,
         ),
+        (
+            "uos_avz",
+            "pgm",
+            975,
+            477,
+            0.05,
+            [0.0, 0.0, 0.0],
+            150467,
+            10668,
+            303940,
+        ),
         // occ 0.2 / free 0.05: free v >= 243, unknown 204..=242, occupied v < 204.
         (
             "intel_lab",
