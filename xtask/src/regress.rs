@@ -19,7 +19,9 @@ Sets (20 cases per row, as in docs/EVALUATION.md):
   zero    every must-decline row, seeds 1, 2, 3, 7        zeroh   hector's, the same seeds
   ovl     every overlap row, seed 7                       ovlh    hector's, seed 7
   large   the nav2 warehouse, seeds 7, 8                  largeh  hector's, seed 8
-All of them took 19 minutes on a 2-core Intel Xeon VM (2026-12-05).
+  floors  five real floors at 30 % overlap, seeds 7, 8
+All of them but floors took 19 minutes on a 2-core Intel Xeon VM (2026-12-05); floors
+takes about 8 more.
 
 Examples:
   cargo xtask regress --out /tmp/before
@@ -116,6 +118,13 @@ const SETS: &[Set] = &[
         only: None,
         hector: true,
         seeds: &[8],
+    },
+    Set {
+        name: "floors",
+        suites: "floors",
+        only: None,
+        hector: false,
+        seeds: &[7, 8],
     },
 ];
 
@@ -222,7 +231,7 @@ mod tests {
                 "o30_7", "o30_8", "o30_9", "o30h_7", "o30h_8", "o30h_9", "real_7", "real_8",
                 "real_9", "realh_8", "realh_9", "zero_1", "zero_2", "zero_3", "zero_7", "zeroh_1",
                 "zeroh_2", "zeroh_3", "zeroh_7", "ovl_7", "ovlh_7", "large_7", "large_8",
-                "largeh_8"
+                "largeh_8", "floors_7", "floors_8"
             ]
         );
         for (_, argv) in &runs {

@@ -18,6 +18,6 @@ mod testmaps;
 
 pub use register::{
     Candidate, KindTotals, ManhattanRotation, Method, Origin, PairConfig, PolishConfig,
-    RegisterConfig, Registration, SpectrumRotation, Timings, framed, refine_and_score, register,
-    register_with,
+    RegisterConfig, Registration, SpectrumRotation, Timings, TurnScan, framed, refine_and_score,
+    register, register_with,
 };
