@@ -21,7 +21,7 @@ Sets (20 cases per row, as in docs/EVALUATION.md):
   large   the nav2 warehouse, seeds 7, 8                  largeh  hector's, seed 8
   floors  five real floors at 30 % overlap, seeds 7, 8
 All of them but floors took 19 minutes on a 2-core Intel Xeon VM (2026-12-05); floors
-takes about 8 more.
+took 4 minutes a seed there.
 
 Examples:
   cargo xtask regress --out /tmp/before
