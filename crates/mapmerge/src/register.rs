@@ -302,8 +302,8 @@ pub struct TurnScan {
     /// 119-156 px (scratch measurement at the truth, seed 7).
     pub min_lever_px: f64,
     /// Scanned only when neither map's share of lone wall cells
-    /// ([`crate::ascent::lone_wall_share`]) exceeds the other's by more than this factor.
-    /// Default 2.2. Walls of sensors with different noise are pushed by different amounts,
+    /// ([`crate::ascent::lone_wall_share`]) exceeds the other's by more than this factor (a
+    /// map without lone wall cells is alike only to another without). Default 2.2. Walls of sensors with different noise are pushed by different amounts,
     /// and on curved walls that bends the best-scoring angle: on the real suite's uos_cic
     /// row (10 % and 20 % noise, a curved hall) the scan without this gate registered 18
     /// instead of 25 of the 40 pairs of seeds 8 and 9. The ratio is 2.31-5.21 on those

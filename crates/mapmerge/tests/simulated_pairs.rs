@@ -3,7 +3,8 @@
 //! (`VerifyConfig::basin_ratio`), the stand-out rule of acceptance (`VerifyConfig::stand_out`),
 //! the spectrum angle's lever (`SpectrumRotation::max_lever_px`), the angle of a large pair
 //! from its walls at right angles (`ManhattanRotation`), the score ascent
-//! (`PairConfig::ascent`), that the answer does not depend on the maps' unknown border
+//! (`PairConfig::ascent`), the angle scanned about the overlap (`PairConfig::turn_scan`), that
+//! the answer does not depend on the maps' unknown border
 //! (`PairConfig::frame_margin`), and a pair drawn by a mapper no setting was chosen on.
 
 use grid_core::metrics::displacement_error;
