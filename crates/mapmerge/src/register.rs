@@ -974,18 +974,18 @@ fn register_as_given(
         origin,
         refined: true,
     };
-    let best_of = |scored: Vec<(Rigid2, Verification)>| {
-        scored
-            .into_iter()
-            .reduce(|best, p| {
-                if p.1.score() > best.1.score() {
-                    p
-                } else {
-                    best
-                }
-            })
-            .expect("at least one start")
+    // The highest-scoring of `scored` (the first of equals), if any.
+    let highest = |scored: Vec<(Rigid2, Verification)>| {
+        scored.into_iter().reduce(|best, p| {
+            if p.1.score() > best.1.score() {
+                p
+            } else {
+                best
+            }
+        })
     };
+    let best_of =
+        |scored: Vec<(Rigid2, Verification)>| highest(scored).expect("at least one start");
     let polished = |starts: &[Rigid2], refine_config: &RefineConfig, origin: Origin| {
         // Side by side: the refinements are independent.
         let scored: Vec<(Rigid2, Verification)> = starts
@@ -1297,14 +1297,14 @@ fn register_as_given(
         } else {
             Vec::new()
         };
-        let turned: Vec<(Rigid2, Verification)> = turns
+        let passing: Vec<(Rigid2, Verification)> = turns
             .par_iter()
-            .filter_map(|d| at_angle(&pa, &pb, &from, from.theta + d, config))
+            .filter_map(|d| {
+                at_angle(&pa, &pb, &from, from.theta + d, config)
+                    .filter(|(_, v)| v.accepted(&config.verify))
+            })
             .collect();
-        if let Some((t, v)) = turned
-            .into_iter()
-            .filter(|(_, v)| v.accepted(&config.verify))
-            .reduce(|x, y| if y.1.score() > x.1.score() { y } else { x })
+        if let Some((t, v)) = highest(passing)
             && v.score() > best.verification.score()
         {
             (best.transform, best.verification) = (t.normalized(), v);
