@@ -550,11 +550,14 @@ fn floor_case(floor: OccupancyGrid, seed: u64) -> Case {
     generate_case(&config, seed).unwrap()
 }
 
-/// Case 7000005 of `cargo xtask eval --suites large --seed 7`: two robots in the nav2
-/// warehouse (1006 x 1674 cells), maps about 1500 x 1600 cells overlapping by 30 %. ICP and
-/// the verification score both settle on an angle 0.49 degrees off (4.7 px on average over
-/// B's cells): the overlap's walls, tilted in each map its own way, do not pin it over B's
-/// far cells. The two maps' dominant wall directions do (`mapmerge::ManhattanRotation`).
+/// Case 7000001 of `cargo xtask eval --suites large --seed 7`: two robots in the nav2
+/// warehouse (1006 x 1674 cells), maps overlapping by 30 %. Without the Manhattan angle the
+/// answer is 0.34 degrees off (3.54 px on average over B's cells): the overlap's walls, tilted
+/// in each map its own way, do not pin the angle over B's far cells. The two maps' dominant
+/// wall directions do (`mapmerge::ManhattanRotation`): 0.10 degrees, 0.95 px. Case 7000005
+/// showed it until the edge test of the keypoints stopped favouring turned edges (2026-12-05,
+/// docs/EVALUATION.md, "An edge test that does not depend on the edge's direction"): since,
+/// its answer has the angle within 0.03 degrees but the translation 3.07 px off.
 #[test]
 fn a_large_warehouse_pair_takes_its_angle_from_the_walls_at_right_angles() {
     let case = floor_case(
@@ -566,12 +569,12 @@ fn a_large_warehouse_pair_takes_its_angle_from_the_walls_at_right_angles() {
             &Default::default(),
         )
         .unwrap(),
-        7_000_005,
+        7_000_001,
     );
     let (_, error) = registered(&case, &RegisterConfig::default());
     assert!(error.is_some_and(|e| e < 1.5), "{error:?}");
     let mut without = RegisterConfig::default();
     without.pair.manhattan_rotation = None;
     let (_, error) = registered(&case, &without);
-    assert!(error.is_some_and(|e| e > 4.0), "without: {error:?}");
+    assert!(error.is_some_and(|e| e > 3.0), "without: {error:?}");
 }

@@ -69,7 +69,12 @@ pub struct ScaleSpaceConfig {
     /// DoG contrast threshold for images in `[0, 1]` (IPOL `C_DoG`): default `0.04 / 3`
     /// (Lowe/OpenCV's 0.04 over 3 scales).
     pub c_dog: f32,
-    /// Edge threshold on the ratio of principal curvatures (IPOL `C_edge`): default 10.
+    /// Edge threshold on the ratio of principal curvatures (IPOL `C_edge`): default 10. The
+    /// curvatures come from the DoG's spatial Hessian, whose second differences along `x` and
+    /// `y` are averaged over the 3 x 3 footprint of the cross difference (weights 1, 2, 1
+    /// across), unlike IPOL's 3-point ones: with those, a wall's edge turned to a staircase by a
+    /// rotation passed the test along its whole length (see `detect.rs` and docs/EVALUATION.md,
+    /// "An edge test that does not depend on the edge's direction").
     pub c_edge: f32,
     /// Octaves are added while their short side has at least this many samples: default 12.
     pub min_octave_size: usize,

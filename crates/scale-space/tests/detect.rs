@@ -260,3 +260,51 @@ fn a_coarse_first_octave_needs_enough_blur() {
         Err(scale_space::Error::Config("delta_min must be in (0, 2]"))
     );
 }
+
+/// `img` turned by `theta` about its centre onto an `n x n` canvas (n the image's diagonal),
+/// nearest neighbour, as a map is warped: straight edges become staircases. Outside: 0.
+fn turned_nearest(img: &Image, theta: f32) -> Image {
+    let (w, h) = (img.width as f32, img.height as f32);
+    let n = (w * w + h * h).sqrt().ceil() as usize;
+    let (sin, cos) = theta.sin_cos();
+    let c = (n as f32 - 1.0) / 2.0;
+    let (cx, cy) = ((w - 1.0) / 2.0, (h - 1.0) / 2.0);
+    let mut out = Image::filled(n, n, 0.0);
+    for y in 0..n {
+        for x in 0..n {
+            let (u, v) = (x as f32 - c, y as f32 - c);
+            let (sx, sy) = (cos * u + sin * v + cx, -sin * u + cos * v + cy);
+            let (ix, iy) = (sx.round(), sy.round());
+            if ix >= 0.0 && iy >= 0.0 && ix < w && iy < h {
+                out.data[y * n + x] = img.at(ix as usize, iy as usize);
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn a_turned_copy_has_about_as_many_keypoints() {
+    // The edge test reads the spatial Hessian of the DoG; with plain 3-point second
+    // differences a straight edge turned to a staircase at 30 degrees passed it all along its
+    // length (the nav2 warehouse map turned by 30 degrees: 4152 keypoints against 738). With
+    // the second differences averaged over the cross difference's 3 x 3 footprint, 765. Here
+    // (measured): 154, 139 and 149 keypoints at 30, 45 and 60 degrees against 139, where the
+    // plain differences gave 236, 169 and 235 against 141.
+    let img = rooms(257);
+    // The same canvas for both: the unturned picture at the centre of its turned size.
+    let config = ScaleSpaceConfig {
+        crop_margin: None,
+        ..ScaleSpaceConfig::default()
+    };
+    let straight = detect(&turned_nearest(&img, 0.0), &config).len();
+    for deg in [30f32, 45.0, 60.0] {
+        let turned = detect(&turned_nearest(&img, deg.to_radians()), &config).len();
+        assert!(straight > 50, "too few keypoints to be a test: {straight}");
+        let ratio = turned as f64 / straight as f64;
+        assert!(
+            (0.75..1.33).contains(&ratio),
+            "{deg} degrees: {turned} keypoints against {straight} unturned"
+        );
+    }
+}
