@@ -101,10 +101,20 @@ proptest! {
     /// contradiction 0.04, acceptance index 0.98, 77 % overlap). With the walls' shadow compared
     /// (`VerifyConfig::shadow_px`, 2026-12-03) the first failure is an answer 78.0 px off at
     /// wall lift 0.86.
-    /// The failing cases are kept in `properties.proptest-regressions`,
-    /// so `cargo test -p mapmerge --test properties -- --ignored` shows them first.
+    /// Those failing cases are kept in `properties.proptest-regressions`, which proptest runs
+    /// first, and all three pass since; so do the 8 cases of the fixed seed, and this test,
+    /// ignored until 2026-12-05, runs with the others. It still fails elsewhere (measured
+    /// 2026-12-05 evening, 13809db): at 40 cases (`MAPMERGE_PROPTEST_SEED=S PROPTEST_CASES=40
+    /// cargo test -p mapmerge --test properties overlapping`) seeds 1, 2, 3, 5 and 7 pass and
+    /// seed 6 fails with an answer 5.3 px off; at 100 cases seed 4 fails on a 157 x 141 room
+    /// whose answer is the truth's half-turn twin, 91 px off (wall lift 0.87, contradiction
+    /// 0.03). There the truth fits better (refined: wall lift 0.89, contradiction 0), so as a
+    /// candidate it would have made the pair ambiguous and declined; but no candidate came
+    /// within 10 px of it: the sweep's and the probes' placements at its angle sit 11-14 px
+    /// away, beyond the local search's 8 px, and refine to a poorer fit (wall lift 0.64).
+    /// A run that fails adds its case to the regressions file; keep it out of a commit
+    /// unless the case passes.
     #[test]
-    #[ignore = "known false accepts on small repetitive maps (see the doc comment)"]
     fn overlapping_robot_maps_are_registered(
         (a, b, truth) in map_pair(PairParams { size: 250..=320, overlap: 0.6..=0.8, noise: 0.0..=0.05, beams: vec![360], worlds: Worlds::Both, ..PairParams::default() }),
     ) {
