@@ -284,6 +284,11 @@ pub struct EvalArgs {
     /// the library's), for calibration experiments.
     #[arg(long)]
     search_points: Option<usize>,
+    /// Override the largest translation the correlative local search tries along each axis, in
+    /// pixels, for both its searches (`mapmerge::search::SearchConfig::radius_px`; default: the
+    /// library's), for calibration experiments.
+    #[arg(long)]
+    search_radius: Option<f64>,
     /// Override how far the overlap's wall centroid must lie from all of B's walls' for the
     /// correlative local search to turn B about it, in pixels, for both its searches
     /// (`mapmerge::search::SearchConfig::overlap_pivot_px`; `inf` never; default: the
@@ -846,6 +851,11 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
     if let Some(n) = args.search_points {
         for search in config.pair.searches_mut() {
             search.max_points = n;
+        }
+    }
+    if let Some(px) = args.search_radius {
+        for search in config.pair.searches_mut() {
+            search.radius_px = px;
         }
     }
     if let Some(px) = args.search_overlap_pivot {
