@@ -111,7 +111,9 @@ proptest! {
     /// 0.03). There the truth fits better (refined: wall lift 0.89, contradiction 0), so as a
     /// candidate it would have made the pair ambiguous and declined; but no candidate came
     /// within 10 px of it: the sweep's and the probes' placements at its angle sit 11-14 px
-    /// away, beyond the local search's 8 px, and refine to a poorer fit (wall lift 0.64).
+    /// away and refine to a poorer fit (wall lift 0.64), and the local search, even over
+    /// +-24 px instead of 8 (scratch code), stays at the probe's placement, whose walls it
+    /// scores higher than the truth's: that placement overlaps more.
     /// A run that fails adds its case to the regressions file; keep it out of a commit
     /// unless the case passes.
     #[test]
