@@ -47,36 +47,39 @@ use mapmerge::verify::{PreparedMap, VerifyConfig, verify};
 use mapmerge::{RegisterConfig, refine_and_score, register};
 use mapsim::{CaseConfig, generate_case};
 
-fn pair() -> (OccupancyGrid, OccupancyGrid) {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../fixtures/maps/uos_cic/uos_cic.yaml"
+/// Fixture map `name` moved by `a_pose` onto one 2048 x 2048 canvas and by `b_pose` onto
+/// another.
+fn fixture_on_canvases(
+    name: &str,
+    a_pose: Rigid2,
+    b_pose: Rigid2,
+) -> (OccupancyGrid, OccupancyGrid) {
+    let path = format!(
+        "{}/../../fixtures/maps/{name}/{name}.yaml",
+        env!("CARGO_MANIFEST_DIR")
     );
     let map = load_map(path, &LoadOptions::default()).expect("fixture loads");
-    let a = map
-        .warp(&Rigid2::new(0.0, 500.0, 280.0), 2048, 2048)
-        .expect("canvas");
-    let b = map
-        .warp(&Rigid2::new(30f64.to_radians(), 900.0, 150.0), 2048, 2048)
-        .expect("canvas");
-    (a, b)
+    let canvas = |pose: &Rigid2| map.warp(pose, 2048, 2048).expect("canvas");
+    (canvas(&a_pose), canvas(&b_pose))
+}
+
+/// The CIC floor on a 2048 x 2048 canvas, and the same floor turned by 30 degrees on another.
+fn pair() -> (OccupancyGrid, OccupancyGrid) {
+    fixture_on_canvases(
+        "uos_cic",
+        Rigid2::new(0.0, 500.0, 280.0),
+        Rigid2::new(30f64.to_radians(), 900.0, 150.0),
+    )
 }
 
 /// The nav2 warehouse on a 2048 x 2048 canvas, and the same map turned by 30 degrees (its
 /// corners within the canvas) on another.
 fn warehouse_pair() -> (OccupancyGrid, OccupancyGrid) {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../fixtures/maps/nav2_warehouse/nav2_warehouse.yaml"
-    );
-    let map = load_map(path, &LoadOptions::default()).expect("fixture loads");
-    let a = map
-        .warp(&Rigid2::new(0.0, 500.0, 180.0), 2048, 2048)
-        .expect("canvas");
-    let b = map
-        .warp(&Rigid2::new(30f64.to_radians(), 900.0, 40.0), 2048, 2048)
-        .expect("canvas");
-    (a, b)
+    fixture_on_canvases(
+        "nav2_warehouse",
+        Rigid2::new(0.0, 500.0, 180.0),
+        Rigid2::new(30f64.to_radians(), 900.0, 40.0),
+    )
 }
 
 /// The western and the eastern three quarters of the uos_cic floor (see the module
