@@ -21,7 +21,8 @@ Sets (20 cases per row, as in docs/EVALUATION.md):
   large   the nav2 warehouse, seeds 7, 8                  largeh  hector's, seed 8
   floors  five real floors at 30 % overlap, seeds 7, 8
 All of them but floors took 19 minutes on a 2-core Intel Xeon VM (2026-12-05); floors
-took 4 minutes a seed there.
+took 4 minutes a seed there. In a faster hour of that VM the whole batch, floors included,
+took 20 minutes (2026-12-05, 18:42-19:02 UTC).
 
 Examples:
   cargo xtask regress --out /tmp/before
