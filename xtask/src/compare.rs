@@ -20,8 +20,9 @@ directory of such files (every *.jsonl directly in it). A case's outcome is `reg
 (accepted and within 3 px), `off` (accepted but more than 3 px off, or a pair that must be
 declined), `declined` (the success of a must-decline row), or `failed` (the case did not
 generate). Printed: every case whose outcome changed, and every registered case whose
-displacement error moved by more than --moved; then, per row, the counts of each outcome
-before and after.
+displacement error moved by more than --moved; a count of the cases registered after but not
+before (won) and before but not after (lost), and of how many of the moved ones came nearer
+the truth; then, per row, the counts of each outcome before and after.
 
 Example:
   cargo xtask eval --suites overlap --only \"overlap 0.3\" --seed 7 --out /tmp/before
@@ -173,6 +174,8 @@ pub struct Report {
     /// Cases only one run holds.
     pub only_before: usize,
     pub only_after: usize,
+    /// The distance a registered answer had to move to be listed (pixels).
+    pub moved_px: f64,
 }
 
 /// Compare the cases both runs hold (see [`Report`]). A case a run holds twice (a directory
@@ -187,6 +190,7 @@ pub fn compare(before: &[Case], after: &[Case], moved_px: f64) -> Report {
         rows: BTreeMap::new(),
         only_before: before.keys().filter(|k| !after.contains_key(*k)).count(),
         only_after: after.keys().filter(|k| !before.contains_key(*k)).count(),
+        moved_px,
     };
     for (key, a) in &after {
         let Some(b) = before.get(key) else {
@@ -231,6 +235,22 @@ impl fmt::Display for Report {
                     c.after.describe()
                 )?;
             }
+            let registered = |c: &Case| c.outcome() == Outcome::Registered;
+            let count = |p: &dyn Fn(&Change) -> bool| self.changes.iter().filter(|c| p(c)).count();
+            let won = count(&|c| !registered(&c.before) && registered(&c.after));
+            let lost = count(&|c| registered(&c.before) && !registered(&c.after));
+            let moved = count(&|c| registered(&c.before) && registered(&c.after));
+            let nearer = count(&|c| {
+                registered(&c.before)
+                    && registered(&c.after)
+                    && c.after.displacement_error_px < c.before.displacement_error_px
+            });
+            writeln!(
+                f,
+                "Registered: {won} won, {lost} lost; {nearer} of the {moved} registered both \
+                 times that moved by more than {} px came nearer the truth.",
+                self.moved_px
+            )?;
         }
         writeln!(f, "Per row (registered / off / declined / failed):")?;
         let counts = |m: &BTreeMap<Outcome, usize>| {
@@ -308,6 +328,7 @@ Changed (before -> after):
   overlap | disaster, overlap 0.3, noise 10%/10% | hybrid | 2: off 3.40 px -> registered 2.90 px
   overlap | disaster, overlap 0.3, noise 10%/10% | hybrid | 3: registered 0.50 px -> registered 2.00 px
   overlap | disaster, overlap 0.3, noise 10%/10% | hybrid | 4: declined -> off 250.00 px
+Registered: 1 won, 0 lost; 0 of the 1 registered both times that moved by more than 0.5 px came nearer the truth.
 Per row (registered / off / declined / failed):
   overlap | disaster, overlap 0.3, noise 10%/10% | hybrid: 2 / 1 / 1 / 0 -> 3 / 1 / 0 / 0
 Not compared: 1 cases only in the run before, 1 only in the run after.
