@@ -287,7 +287,7 @@ pub struct EvalArgs {
     /// Override the largest translation the correlative local search tries along each axis, in
     /// pixels, for both its searches (`mapmerge::search::SearchConfig::radius_px`; default: the
     /// library's), for calibration experiments.
-    #[arg(long)]
+    #[arg(long, value_name = "PX", value_parser = non_negative)]
     search_radius: Option<f64>,
     /// Override how far the overlap's wall centroid must lie from all of B's walls' for the
     /// correlative local search to turn B about it, in pixels, for both its searches

@@ -303,8 +303,9 @@ pub struct TurnScan {
     pub min_lever_px: f64,
     /// Scanned only when neither map's share of lone wall cells
     /// ([`crate::ascent::lone_wall_share`]) exceeds the other's by more than this factor (a
-    /// map without lone wall cells is alike only to another without). Default 2.2. Walls of sensors with different noise are pushed by different amounts,
-    /// and on curved walls that bends the best-scoring angle: on the real suite's uos_cic
+    /// map without lone wall cells is alike only to another without). Default 2.2. Walls of
+    /// sensors with different noise are pushed by different amounts, and on curved walls
+    /// that bends the best-scoring angle: on the real suite's uos_cic
     /// row (10 % and 20 % noise, a curved hall) the scan without this gate registered 18
     /// instead of 25 of the 40 pairs of seeds 8 and 9. The ratio is 2.31-5.21 on those
     /// robots' maps (intel_lab and uos_cic, seed 8) and 1.01-2.00 on the floors' robots with
