@@ -79,6 +79,31 @@ impl GridGeometry {
             .rotate(w - DVec2::new(self.origin.x, self.origin.y));
         DVec2::new(local.x / r - 0.5, self.height as f64 - 0.5 - local.y / r)
     }
+
+    /// The geometry of the `width x height` region whose cell `(0, 0)` is cell `(x0, y0)` of
+    /// this grid (`x0`, `y0` may be negative, the region may reach past the grid): the same
+    /// resolution and yaw, the origin moved so that cell `p` of the region lies in the world
+    /// where cell `p + (x0, y0)` of this grid lies.
+    pub fn region(&self, x0: i64, y0: i64, width: usize, height: usize) -> GridGeometry {
+        let r = self.resolution;
+        let o = self.origin;
+        // The lower-left corner of the region's lower-left cell, in this grid's frame.
+        let corner = DVec2::new(
+            x0 as f64 * r,
+            (self.height as f64 - y0 as f64 - height as f64) * r,
+        );
+        let moved = DVec2::new(o.x, o.y) + DVec2::from_angle(o.yaw).rotate(corner);
+        GridGeometry {
+            width,
+            height,
+            resolution: r,
+            origin: Pose2 {
+                x: moved.x,
+                y: moved.y,
+                yaw: o.yaw,
+            },
+        }
+    }
 }
 
 /// A 2-D occupancy grid map.
@@ -367,20 +392,8 @@ impl OccupancyGrid {
                 row[first..last].copy_from_slice(src);
             }
         }
-        let r = self.resolution();
-        let o = self.origin();
-        // The lower-left corner of the region's lower-left cell, in this grid's frame.
-        let corner = DVec2::new(
-            x0 as f64 * r,
-            (self.height() as f64 - y0 as f64 - height as f64) * r,
-        );
-        let moved = DVec2::new(o.x, o.y) + DVec2::from_angle(o.yaw).rotate(corner);
-        let origin = Pose2 {
-            x: moved.x,
-            y: moved.y,
-            yaw: o.yaw,
-        };
-        Self::from_cells(width, height, r, origin, cells)
+        let g = self.geometry.region(x0, y0, width, height);
+        Self::from_cells(width, height, g.resolution, g.origin, cells)
     }
 
     /// World coordinates of pixel coordinates `p`; see [`GridGeometry::pixel_to_world`].
