@@ -170,13 +170,8 @@ pub fn fuse(
             },
         );
     let geometry = reference.region(x0, y0, width, height);
-    let grid = OccupancyGrid::from_cells(
-        width,
-        height,
-        geometry.resolution,
-        geometry.origin,
-        cells,
-    )?;
+    let grid =
+        OccupancyGrid::from_cells(width, height, geometry.resolution, geometry.origin, cells)?;
     Ok(FusedMap {
         grid,
         offset: (x0, y0),
@@ -383,7 +378,11 @@ mod tests {
             },
         )
         .unwrap();
-        assert_eq!(at(&wins, 2, 0), O, "occupied wins over a more reliable free");
+        assert_eq!(
+            at(&wins, 2, 0),
+            O,
+            "occupied wins over a more reliable free"
+        );
         assert_eq!(at(&wins, 1, 0), F);
     }
 
@@ -419,7 +418,9 @@ mod tests {
         assert_eq!(f.agreement.disagree, 0);
         assert_eq!(f.agreement.agree, 8);
         // World coordinates are the reference's (and hence the whole map's).
-        let q = f.grid.world_to_pixel(truth.pixel_to_world(DVec2::new(5.0, 3.0)));
+        let q = f
+            .grid
+            .world_to_pixel(truth.pixel_to_world(DVec2::new(5.0, 3.0)));
         assert!((q - DVec2::new(5.0 - f.offset.0 as f64, 3.0 - f.offset.1 as f64)).length() < 1e-9);
     }
 
@@ -453,22 +454,32 @@ mod tests {
     fn bad_inputs_are_refused() {
         let a = grid(2, 1, vec![F, O]);
         let g = a.geometry();
-        assert!(matches!(
-            fuse(&g, &[], &tight()),
-            Err(FusionError::NoMaps)
-        ));
+        assert!(matches!(fuse(&g, &[], &tight()), Err(FusionError::NoMaps)));
         assert!(matches!(
             fuse(&g, &[place(&a, Rigid2::IDENTITY, f64::NAN)], &tight()),
             Err(FusionError::Weight { index: 0, .. })
         ));
         assert!(matches!(
-            fuse(&g, &[place(&a, Rigid2::IDENTITY, 1.0), place(&a, Rigid2::new(0.0, f64::INFINITY, 0.0), 1.0)], &tight()),
+            fuse(
+                &g,
+                &[
+                    place(&a, Rigid2::IDENTITY, 1.0),
+                    place(&a, Rigid2::new(0.0, f64::INFINITY, 0.0), 1.0)
+                ],
+                &tight()
+            ),
             Err(FusionError::NotFinite { .. })
         ));
-        let coarse =
-            OccupancyGrid::from_cells(2, 1, 0.1, Pose2::default(), vec![F, O]).unwrap();
+        let coarse = OccupancyGrid::from_cells(2, 1, 0.1, Pose2::default(), vec![F, O]).unwrap();
         assert!(matches!(
-            fuse(&g, &[place(&a, Rigid2::IDENTITY, 1.0), place(&coarse, Rigid2::IDENTITY, 1.0)], &tight()),
+            fuse(
+                &g,
+                &[
+                    place(&a, Rigid2::IDENTITY, 1.0),
+                    place(&coarse, Rigid2::IDENTITY, 1.0)
+                ],
+                &tight()
+            ),
             Err(FusionError::Resolution { index: 1, .. })
         ));
         let unknown = grid(2, 1, vec![U, U]);
@@ -477,8 +488,12 @@ mod tests {
             Err(FusionError::NothingKnown)
         ));
         let far = Rigid2::new(0.0, 1e6, 1e6);
-        let err = fuse(&g, &[place(&a, Rigid2::IDENTITY, 1.0), place(&a, far, 1.0)], &tight())
-            .unwrap_err();
+        let err = fuse(
+            &g,
+            &[place(&a, Rigid2::IDENTITY, 1.0), place(&a, far, 1.0)],
+            &tight(),
+        )
+        .unwrap_err();
         assert!(matches!(err, FusionError::TooLarge { .. }), "{err}");
     }
 }

@@ -297,11 +297,7 @@ fn refine(
     let mut out = poses.to_vec();
     for (k, p) in out.iter_mut().enumerate() {
         if p.is_some() && k != reference {
-            let (th, tx, ty) = (
-                angle(k),
-                t[(2 * column[k], 0)],
-                t[(2 * column[k] + 1, 0)],
-            );
+            let (th, tx, ty) = (angle(k), t[(2 * column[k], 0)], t[(2 * column[k] + 1, 0)]);
             if ![th, tx, ty].iter().all(|v| v.is_finite()) {
                 return Err(FusionError::Solve);
             }
@@ -351,7 +347,11 @@ mod tests {
     #[test]
     fn a_chain_composes_its_answers() {
         let t = truth();
-        let edges = [edge(&t, 0, 1, 0.9), edge(&t, 2, 1, 0.8), edge(&t, 2, 3, 0.7)];
+        let edges = [
+            edge(&t, 0, 1, 0.9),
+            edge(&t, 2, 1, 0.8),
+            edge(&t, 2, 3, 0.7),
+        ];
         let s = solve_poses(&centres(4), 0, &edges, &PoseGraphConfig::default()).unwrap();
         assert_eq!(s.status, vec![EdgeStatus::Tree; 3]);
         assert!(worst(&s.poses, &t, DVec2::new(100.0, 80.0)) < 1e-9);
@@ -410,7 +410,12 @@ mod tests {
         };
         assert!(max(&before) > 1.5, "{:?}", before.residuals);
         assert!(max(&after) < 0.6 * max(&before), "{:?}", after.residuals);
-        let rot = |s: &PoseGraphSolution| s.residuals.iter().map(|r| r.rotation_deg).fold(0.0, f64::max);
+        let rot = |s: &PoseGraphSolution| {
+            s.residuals
+                .iter()
+                .map(|r| r.rotation_deg)
+                .fold(0.0, f64::max)
+        };
         assert!((rot(&before) - 0.8).abs() < 1e-9, "{}", rot(&before));
         assert!(rot(&after) < 0.5, "{}", rot(&after));
     }
@@ -437,12 +442,21 @@ mod tests {
         let config = PoseGraphConfig::default();
         let mut e = edge(&t, 0, 1, 0.9);
         e.b = 5;
-        assert!(matches!(solve_poses(&c, 0, &[e], &config), Err(FusionError::BadEdge { .. })));
+        assert!(matches!(
+            solve_poses(&c, 0, &[e], &config),
+            Err(FusionError::BadEdge { .. })
+        ));
         let mut e = edge(&t, 0, 1, 0.9);
         e.b_to_a.tx = f64::NAN;
-        assert!(matches!(solve_poses(&c, 0, &[e], &config), Err(FusionError::NotFinite { .. })));
+        assert!(matches!(
+            solve_poses(&c, 0, &[e], &config),
+            Err(FusionError::NotFinite { .. })
+        ));
         let e = edge(&t, 0, 1, 0.0);
-        assert!(matches!(solve_poses(&c, 0, &[e], &config), Err(FusionError::NotFinite { .. })));
+        assert!(matches!(
+            solve_poses(&c, 0, &[e], &config),
+            Err(FusionError::NotFinite { .. })
+        ));
     }
 
     proptest! {

@@ -12,6 +12,8 @@ const AFTER_HELP: &str = "\
 Examples:
   mapmerge estimate fixtures/maps/sunil_pair_a/sunil_pair_a.yaml fixtures/maps/sunil_pair_b/sunil_pair_b.yaml
   mapmerge estimate a.yaml b.yaml --json --debug-png matches.png
+  mapmerge merge fixtures/maps/sunil_pair_a/sunil_pair_a.yaml fixtures/maps/sunil_pair_b/sunil_pair_b.yaml -o merged.yaml
+  mapmerge merge robot1.yaml robot2.yaml robot3.yaml -o team.yaml --weights 1,1,0.5
   mapmerge info fixtures/maps/wpi_ilab/wpi_ilab.yaml
   mapmerge info --json maps/robot1.yaml
   mapmerge info scan.pgm --resolution 0.1 --negate
@@ -21,8 +23,9 @@ image (.pgm/.pnm/.png). A bare image is read as a trinary map with resolution 0.
 origin [0, 0, 0], occupied_thresh 0.65 and free_thresh 0.196 unless the flags above say
 otherwise; those flags do not change maps given by YAML.
 
-Exit codes: 0 success, 3 no trustworthy match (estimate declined the pair), 2 bad usage or
-bad input (one line on stderr naming the file and the problem), 1 internal error.";
+Exit codes: 0 success, 3 no trustworthy match (estimate declined the pair, or merge could
+place no map in the first map's frame), 2 bad usage or bad input (one line on stderr naming
+the file and the problem), 1 internal error.";
 
 /// Merge the occupancy grid maps of a robot team without knowing where each robot started.
 #[derive(Debug, Parser)]
@@ -40,6 +43,9 @@ enum Command {
     Info(cmd::info::InfoArgs),
     /// Find the rigid transform that maps map B onto map A, or decline the pair (exit 3).
     Estimate(cmd::estimate::EstimateArgs),
+    /// Register every pair of maps, place them all in the first map's frame and fuse them into
+    /// one map (PGM + YAML) with a JSON report of every map's pose.
+    Merge(cmd::merge::MergeArgs),
 }
 
 fn main() -> ExitCode {
@@ -51,6 +57,7 @@ fn main() -> ExitCode {
         match &cli.command {
             Command::Info(args) => cmd::info::run(args, &cli.bare),
             Command::Estimate(args) => cmd::estimate::run(args, &cli.bare),
+            Command::Merge(args) => cmd::merge::run(args, &cli.bare),
         }
     })
 }

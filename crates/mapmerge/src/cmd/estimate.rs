@@ -10,7 +10,7 @@ use grid_core::{CellState, DVec2, OccupancyGrid, Rigid2};
 use mapmerge::{Method, RegisterConfig, Registration, register};
 use serde_json::json;
 
-use super::{BareImageArgs, UsageError, load};
+use super::{BareImageArgs, UsageError, load, refuse_overwriting, require_directory};
 
 const AFTER: &str = "\
 Output (--json): one JSON object on stdout.
@@ -72,47 +72,18 @@ fn parse_method(s: &str) -> Result<Method, String> {
     s.parse()
 }
 
-fn same_file(a: &Path, b: &Path) -> bool {
-    match (a.canonicalize(), b.canonicalize()) {
-        (Ok(x), Ok(y)) => x == y,
-        _ => a == b,
-    }
-}
-
-/// A usage error when `png` is one of `inputs`.
-fn refuse_overwriting<'a>(
-    png: &Path,
-    inputs: impl IntoIterator<Item = &'a PathBuf>,
-) -> Result<(), UsageError> {
-    if inputs.into_iter().any(|input| same_file(png, input)) {
-        return Err(UsageError(format!(
-            "{}: --debug-png would overwrite an input map; choose another file",
-            png.display()
-        )));
-    }
-    Ok(())
-}
-
 /// Run `mapmerge estimate`.
 pub fn run(args: &EstimateArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode> {
     if let Some(png) = &args.debug_png {
-        refuse_overwriting(png, [&args.a, &args.b])?;
+        refuse_overwriting(png, "--debug-png", [&args.a, &args.b])?;
         // Checked before the registration's work, not after it.
-        let dir = png.parent().filter(|d| !d.as_os_str().is_empty());
-        if let Some(dir) = dir.filter(|d| !d.is_dir()) {
-            return Err(UsageError(format!(
-                "{}: --debug-png's directory {} does not exist",
-                png.display(),
-                dir.display()
-            ))
-            .into());
-        }
+        require_directory(png, "--debug-png")?;
     }
     let a = load(&args.a, bare)?;
     let b = load(&args.b, bare)?;
     if let Some(png) = &args.debug_png {
         // A map given by its YAML is read from the image the YAML names.
-        refuse_overwriting(png, [&a.image_path, &b.image_path])?;
+        refuse_overwriting(png, "--debug-png", [&a.image_path, &b.image_path])?;
     }
     grid_core::io::require_known_cells(&a.grid, &args.a)?;
     grid_core::io::require_known_cells(&b.grid, &args.b)?;

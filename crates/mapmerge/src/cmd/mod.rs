@@ -7,7 +7,9 @@
 
 pub mod estimate;
 pub mod info;
+pub mod merge;
 
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::Context;
@@ -172,6 +174,43 @@ pub fn load(path: &std::path::Path, bare: &BareImageArgs) -> anyhow::Result<Load
     Ok(grid_core::io::load_map_with_metadata(path, &options)?)
 }
 
+/// Whether `a` and `b` name the same file (compared after resolving links when both exist).
+fn same_file(a: &Path, b: &Path) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(x), Ok(y)) => x == y,
+        _ => a == b,
+    }
+}
+
+/// A usage error when the output `out` (given by `flag`) is one of `inputs`.
+pub fn refuse_overwriting<'a>(
+    out: &Path,
+    flag: &str,
+    inputs: impl IntoIterator<Item = &'a PathBuf>,
+) -> Result<(), UsageError> {
+    if inputs.into_iter().any(|input| same_file(out, input)) {
+        return Err(UsageError(format!(
+            "{}: {flag} would overwrite an input map; choose another file",
+            out.display()
+        )));
+    }
+    Ok(())
+}
+
+/// A usage error when the folder the output `out` (given by `flag`) goes to does not exist:
+/// checked before the work, not after it.
+pub fn require_directory(out: &Path, flag: &str) -> Result<(), UsageError> {
+    let dir = out.parent().filter(|d| !d.as_os_str().is_empty());
+    if let Some(dir) = dir.filter(|d| !d.is_dir()) {
+        return Err(UsageError(format!(
+            "{}: {flag}'s directory {} does not exist",
+            out.display(),
+            dir.display()
+        )));
+    }
+    Ok(())
+}
+
 fn parse_f64(s: &str) -> Result<f64, String> {
     s.trim()
         .parse::<f64>()
@@ -199,7 +238,6 @@ fn probability(s: &str) -> Result<f64, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::path::PathBuf;
 
     #[test]
     fn exit_codes_follow_the_conventions() {

@@ -1,0 +1,598 @@
+//! `mapmerge merge MAP MAP... -o OUT.yaml`: register every pair of maps, solve one pose per map
+//! in the first map's frame, fuse the maps into one, and report every map's pose.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Instant;
+
+use anyhow::Context;
+use clap::Args;
+use fusion::{
+    EdgeStatus, FusedMap, FusionConfig, FusionRule, MapPlacement, PairEdge, PoseGraphConfig,
+    solve_poses,
+};
+use grid_core::io::{LoadedMap, image_path_for, save_map, write_atomic};
+use grid_core::{CellState, DVec2, OccupancyGrid, Rigid2};
+use mapmerge::{Method, RegisterConfig, Registration, register};
+use rayon::prelude::*;
+use serde_json::{Value, json};
+
+use super::{BareImageArgs, UsageError, load, refuse_overwriting, require_directory};
+
+const AFTER: &str = "\
+How it works: every pair of maps is registered as `mapmerge estimate` does (n maps: n(n-1)/2
+pairs, in parallel). The accepted pairs form a graph; a spanning tree of the most confident
+answers places every map it reaches in the first map's frame, and the answers that close loops
+refine those poses by least squares (an answer that disagrees with the tree by more than 3
+degrees or 8 px is dropped as wrong). The placed maps are then fused: where one map alone is
+known it keeps its cell; where several are, the cell takes their occupancy probabilities'
+mean weighted by --weights (the paper's alpha * M1 + beta * M2, alpha + beta = 1), or with
+--rule occupied-wins the wall any map saw.
+
+Output:
+  OUT.yaml + OUT.pgm  the merged map, as map_saver writes it (0 occupied, 254 free, 205
+                      unknown), in the first map's world frame: a point has the same world
+                      coordinates in the merged map as in the first map
+  OUT.json            the report (also printed by --json):
+    maps              per input: merged (true/false), weight, transform {theta, tx, ty} from
+                      its pixels to the merged map's pixels (x = column, y = row from the top),
+                      world {x, y, yaw}: its map frame in the merged map's frame (metres, yaw
+                      counter-clockwise), ready to publish as a TF; reason when not merged
+    pairs             per pair a < b: accepted, transform (b's pixels onto a's), confidence,
+                      status (tree, loop, dropped, declined, unreached), residual of the
+                      final poses against the pair's answer (rotation_deg, translation_px)
+    acceptance_index  agree / (agree + disagree) over every two maps known at the same cell
+    overlap_cells, output, timings_ms
+
+A map that no accepted pair links to the first map is left out (a warning on stderr says so)
+and the others are merged. When no map links to the first, nothing is written.
+
+Exit codes: 0 merged map written, 3 no map could be placed in the first map's frame (nothing
+written), 2 bad usage or bad input, 1 internal error.
+
+Examples:
+  mapmerge merge fixtures/maps/sunil_pair_a/sunil_pair_a.yaml fixtures/maps/sunil_pair_b/sunil_pair_b.yaml -o merged.yaml
+  mapmerge merge robot1.yaml robot2.yaml robot3.yaml -o team.yaml --weights 1,1,0.5 --debug-png team.png";
+
+/// Arguments of `mapmerge merge`.
+#[derive(Debug, Clone, Args)]
+#[command(after_help = AFTER)]
+pub struct MergeArgs {
+    /// The maps (two or more: map_server YAMLs or bare .pgm/.png images). The first is the
+    /// reference: the merged map is in its frame
+    #[arg(value_name = "MAP", num_args = 2.., required = true)]
+    pub maps: Vec<PathBuf>,
+    /// The merged map's YAML (.yaml or .yml); its PGM is written beside it with the same name
+    /// and the report as OUT.json
+    #[arg(short, long, value_name = "OUT.yaml")]
+    pub output: PathBuf,
+    /// Reliability of each map, in the order given, e.g. 1,0.5: overlapping cells take the mean
+    /// weighted by them [default: all equal]
+    #[arg(long, value_name = "W,W,...", value_delimiter = ',', value_parser = super::positive_finite)]
+    pub weights: Option<Vec<f64>>,
+    /// How overlapping cells are combined: mean (the reliability-weighted mean; a cell one map
+    /// sees free and an equally reliable one occupied becomes unknown) or occupied-wins (a wall
+    /// any map saw stays)
+    #[arg(long, default_value = "mean", value_parser = parse_rule)]
+    pub rule: FusionRule,
+    /// Print the report as one JSON object instead of text
+    #[arg(long)]
+    pub json: bool,
+    /// Evidence used for correspondences: sift, blobs or hybrid (as for estimate)
+    #[arg(long, default_value = "hybrid", value_parser = parse_method)]
+    pub method: Method,
+    /// Seed of RANSAC; the same seed gives the same merged map
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Write a picture of the merged map: free white, unknown grey, walls in the colour of the
+    /// one map that saw them (the first blue, then red, green, orange, purple, ...), black where
+    /// two maps or more saw them
+    #[arg(long, value_name = "FILE")]
+    pub debug_png: Option<PathBuf>,
+}
+
+fn parse_method(s: &str) -> Result<Method, String> {
+    s.parse()
+}
+
+fn parse_rule(s: &str) -> Result<FusionRule, String> {
+    s.parse()
+}
+
+/// The files `mapmerge merge` writes.
+struct Outputs {
+    yaml: PathBuf,
+    image: PathBuf,
+    report: PathBuf,
+}
+
+impl Outputs {
+    fn new(yaml: &Path) -> anyhow::Result<Self> {
+        let ext = yaml
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase());
+        if !matches!(ext.as_deref(), Some("yaml" | "yml")) {
+            return Err(UsageError(format!(
+                "{}: the output must be a .yaml or .yml file (its PGM and JSON report are \
+                 written beside it)",
+                yaml.display()
+            ))
+            .into());
+        }
+        Ok(Self {
+            yaml: yaml.to_path_buf(),
+            image: image_path_for(yaml),
+            report: yaml.with_extension("json"),
+        })
+    }
+
+    /// Every output with the flag that names it.
+    fn all<'a>(&'a self, png: Option<&'a PathBuf>) -> Vec<(&'a Path, &'static str)> {
+        let mut v = vec![
+            (self.yaml.as_path(), "--output"),
+            (self.image.as_path(), "--output's PGM"),
+            (self.report.as_path(), "--output's JSON report"),
+        ];
+        if let Some(p) = png {
+            v.push((p.as_path(), "--debug-png"));
+        }
+        v
+    }
+}
+
+/// Run `mapmerge merge`.
+pub fn run(args: &MergeArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode> {
+    let start = Instant::now();
+    let outputs = Outputs::new(&args.output)?;
+    let written = outputs.all(args.debug_png.as_ref());
+    for (out, flag) in &written {
+        refuse_overwriting(out, flag, &args.maps)?;
+        require_directory(out, flag)?;
+    }
+    if let Some(png) = &args.debug_png {
+        if written[..3].iter().any(|(out, _)| out == png) {
+            return Err(UsageError(format!(
+                "{}: --debug-png names one of the merged map's own files; choose another",
+                png.display()
+            ))
+            .into());
+        }
+    }
+    let weights = match &args.weights {
+        Some(w) if w.len() != args.maps.len() => {
+            return Err(UsageError(format!(
+                "--weights gives {} values for {} maps; give one per map, in the order of the maps",
+                w.len(),
+                args.maps.len()
+            ))
+            .into());
+        }
+        Some(w) => w.clone(),
+        None => vec![1.0; args.maps.len()],
+    };
+    let maps = load_all(&args.maps, bare)?;
+    for (out, flag) in &written {
+        // A map given by its YAML is read from the image the YAML names.
+        refuse_overwriting(out, flag, maps.iter().map(|m| &m.image_path))?;
+    }
+
+    let mut config = RegisterConfig {
+        method: args.method,
+        ..RegisterConfig::default()
+    };
+    config.pair.ransac.seed = args.seed;
+    let t_register = Instant::now();
+    let pairs = register_pairs(&maps, &config)?;
+    let register_ms = t_register.elapsed().as_secs_f64() * 1e3;
+
+    let edges: Vec<PairEdge> = pairs
+        .iter()
+        .filter_map(|p| {
+            p.registration.accepted.as_ref().map(|c| PairEdge {
+                a: p.a,
+                b: p.b,
+                b_to_a: c.transform,
+                weight: c.verification.wall_lift.clamp(0.01, 1.0),
+            })
+        })
+        .collect();
+    let centres: Vec<DVec2> = maps.iter().map(|m| known_centre(&m.grid)).collect();
+    let solution = solve_poses(&centres, 0, &edges, &PoseGraphConfig::default())
+        .context("solving the maps' poses")?;
+    // Each accepted pair's edge, by pair index.
+    let mut edge_of = vec![None; pairs.len()];
+    let mut next = 0;
+    for (i, p) in pairs.iter().enumerate() {
+        if p.registration.accepted.is_some() {
+            edge_of[i] = Some(next);
+            next += 1;
+        }
+    }
+    let reached: Vec<usize> = (0..maps.len())
+        .filter(|&k| solution.poses[k].is_some())
+        .collect();
+
+    let mut report = json!({
+        "reference": args.maps[0].display().to_string(),
+        "rule": match args.rule {
+            FusionRule::WeightedMean => "mean",
+            FusionRule::OccupiedWins => "occupied-wins",
+        },
+        "method": args.method,
+        "seed": args.seed,
+        "pairs": pairs.iter().enumerate().map(|(i, p)| {
+            pair_report(&args.maps, p, edge_of[i].map(|e| (solution.status[e], solution.residuals[e])))
+        }).collect::<Vec<_>>(),
+    });
+    let mut map_reports: Vec<Value> = args
+        .maps
+        .iter()
+        .zip(&weights)
+        .map(|(path, w)| {
+            json!({
+                "map": path.display().to_string(),
+                "merged": false,
+                "weight": w,
+                "transform": null,
+                "world": null,
+                "reason": format!("no accepted pair links it to {}", args.maps[0].display()),
+            })
+        })
+        .collect();
+
+    if reached.len() < 2 {
+        report["output"] = Value::Null;
+        report["reason"] = json!(format!(
+            "no map could be placed in {}'s frame: every pair with it was declined",
+            args.maps[0].display()
+        ));
+        report["maps"] = json!(map_reports);
+        report["timings_ms"] =
+            json!({"register": register_ms, "total": start.elapsed().as_secs_f64() * 1e3});
+        print_report(args, &report)?;
+        return Ok(ExitCode::from(3));
+    }
+
+    let t_fuse = Instant::now();
+    let placements: Vec<MapPlacement<'_>> = reached
+        .iter()
+        .map(|&k| MapPlacement {
+            grid: &maps[k].grid,
+            pose: solution.poses[k].expect("reached"),
+            weight: weights[k],
+        })
+        .collect();
+    let fusion_config = FusionConfig {
+        rule: args.rule,
+        ..FusionConfig::default()
+    };
+    let fused =
+        fusion::fuse(&maps[0].grid.geometry(), &placements, &fusion_config).map_err(|e| {
+            UsageError(format!(
+                "{}: cannot fuse the maps: {e}",
+                args.output.display()
+            ))
+        })?;
+    let fuse_ms = t_fuse.elapsed().as_secs_f64() * 1e3;
+
+    let out_geometry = fused.grid.geometry();
+    for (slot, &k) in reached.iter().enumerate() {
+        let pose = fused.poses[slot];
+        let world = pose.to_world(&out_geometry, &maps[k].grid.geometry());
+        map_reports[k] = json!({
+            "map": args.maps[k].display().to_string(),
+            "merged": true,
+            "weight": weights[k],
+            "transform": {"theta": pose.theta, "tx": pose.tx, "ty": pose.ty},
+            "world": {"x": world.tx, "y": world.ty, "yaw": world.theta},
+        });
+    }
+    let counts = fused.grid.counts();
+    let origin = fused.grid.origin();
+    report["output"] = json!({
+        "yaml": outputs.yaml.display().to_string(),
+        "image": outputs.image.display().to_string(),
+        "report": outputs.report.display().to_string(),
+        "width": fused.grid.width(),
+        "height": fused.grid.height(),
+        "resolution": fused.grid.resolution(),
+        "origin": [origin.x, origin.y, origin.yaw],
+        "free": counts.free,
+        "occupied": counts.occupied,
+        "unknown": counts.unknown,
+    });
+    report["maps"] = json!(map_reports);
+    report["acceptance_index"] = json!(fused.agreement.acceptance_index());
+    report["overlap_cells"] = json!(fused.overlap_cells);
+    report["timings_ms"] = json!({
+        "register": register_ms,
+        "fuse": fuse_ms,
+        "total": start.elapsed().as_secs_f64() * 1e3,
+    });
+
+    write_outputs(&outputs, &fused, &report)?;
+    if let Some(png) = &args.debug_png {
+        write_picture(png, &fused)?;
+    }
+    for (k, r) in map_reports.iter().enumerate() {
+        if r["merged"] == false {
+            eprintln!(
+                "mapmerge: warning: {}: not merged: {}",
+                args.maps[k].display(),
+                r["reason"].as_str().unwrap_or("?")
+            );
+        }
+    }
+    print_report(args, &report)?;
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Load every map, check each has known cells and that all share the first one's resolution.
+fn load_all(paths: &[PathBuf], bare: &BareImageArgs) -> anyhow::Result<Vec<LoadedMap>> {
+    let maps = paths
+        .iter()
+        .map(|p| {
+            let m = load(p, bare)?;
+            grid_core::io::require_known_cells(&m.grid, p)?;
+            Ok(m)
+        })
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let r0 = maps[0].grid.resolution();
+    for (m, p) in maps.iter().zip(paths).skip(1) {
+        let r = m.grid.resolution();
+        if ((r - r0) / r0).abs() > 1e-6 {
+            return Err(UsageError(format!(
+                "{}: resolution {r} m/cell differs from {}'s {r0} m/cell; a rigid pixel \
+                 transform needs equal resolutions, so resample one map first",
+                p.display(),
+                paths[0].display()
+            ))
+            .into());
+        }
+    }
+    Ok(maps)
+}
+
+/// One registered pair: `b` onto `a`, `a < b`.
+struct Pair {
+    a: usize,
+    b: usize,
+    registration: Registration,
+}
+
+/// Register every pair `a < b` in parallel, with a progress bar on a terminal.
+fn register_pairs(maps: &[LoadedMap], config: &RegisterConfig) -> anyhow::Result<Vec<Pair>> {
+    let n = maps.len();
+    let indices: Vec<(usize, usize)> = (0..n)
+        .flat_map(|a| (a + 1..n).map(move |b| (a, b)))
+        .collect();
+    // Drawn on stderr, and only when it is a terminal: scripts and pipes see nothing.
+    let bar = indicatif::ProgressBar::new(indices.len() as u64).with_style(
+        indicatif::ProgressStyle::with_template(
+            "registering pairs [{bar:30}] {pos}/{len} ({elapsed})",
+        )
+        .expect("a valid template")
+        .progress_chars("=> "),
+    );
+    let pairs = indices
+        .par_iter()
+        .map(|&(a, b)| {
+            let registration = register(&maps[a].grid, &maps[b].grid, config)
+                .context("invalid registration settings")?;
+            bar.inc(1);
+            Ok(Pair { a, b, registration })
+        })
+        .collect::<anyhow::Result<Vec<_>>>();
+    bar.finish_and_clear();
+    pairs
+}
+
+/// The mean pixel of a map's known cells (the maps are checked to have some).
+fn known_centre(g: &OccupancyGrid) -> DVec2 {
+    let (mut sum, mut n) = (DVec2::ZERO, 0usize);
+    for y in 0..g.height() {
+        for x in 0..g.width() {
+            if g.state(x, y) != CellState::Unknown {
+                sum += DVec2::new(x as f64, y as f64);
+                n += 1;
+            }
+        }
+    }
+    if n == 0 {
+        DVec2::new(g.width() as f64, g.height() as f64) * 0.5
+    } else {
+        sum / n as f64
+    }
+}
+
+fn transform_json(t: &Rigid2) -> Value {
+    json!({"theta": t.theta, "tx": t.tx, "ty": t.ty})
+}
+
+fn pair_report(
+    paths: &[PathBuf],
+    p: &Pair,
+    edge: Option<(EdgeStatus, fusion::EdgeResidual)>,
+) -> Value {
+    let r = &p.registration;
+    let mut v = json!({
+        "a": paths[p.a].display().to_string(),
+        "b": paths[p.b].display().to_string(),
+        "accepted": r.accepted.is_some(),
+    });
+    match (&r.accepted, edge) {
+        (Some(c), Some((status, residual))) => {
+            v["transform"] = transform_json(&c.transform);
+            v["confidence"] = json!(c.verification.wall_lift.clamp(0.0, 1.0));
+            v["status"] = json!(match status {
+                EdgeStatus::Tree => "tree",
+                EdgeStatus::Loop => "loop",
+                EdgeStatus::Dropped => "dropped",
+                EdgeStatus::Unreached => "unreached",
+            });
+            v["residual"] = json!({
+                "rotation_deg": residual.rotation_deg,
+                "translation_px": residual.translation_px,
+            });
+        }
+        _ => {
+            v["transform"] = Value::Null;
+            v["status"] = json!("declined");
+            v["reason"] = json!(
+                r.reason
+                    .clone()
+                    .unwrap_or_else(|| "no trustworthy match".into())
+            );
+        }
+    }
+    v
+}
+
+/// Write the merged map (PGM + YAML) and the report, each atomically. If the report cannot be
+/// written, the map just written is removed, so that no half of a result is left behind.
+fn write_outputs(outputs: &Outputs, fused: &FusedMap, report: &Value) -> anyhow::Result<()> {
+    save_map(&fused.grid, &outputs.yaml).context("cannot write the merged map")?;
+    let text = serde_json::to_string_pretty(report).context("cannot encode the report")?;
+    if let Err(e) = write_atomic(&outputs.report, format!("{text}\n").as_bytes()) {
+        let _ = std::fs::remove_file(&outputs.yaml);
+        let _ = std::fs::remove_file(&outputs.image);
+        return Err(e).context("cannot write the merge report");
+    }
+    Ok(())
+}
+
+fn print_report(args: &MergeArgs, report: &Value) -> anyhow::Result<()> {
+    let mut stdout = std::io::stdout().lock();
+    if args.json {
+        writeln!(stdout, "{report}").context("cannot write to stdout")?;
+    } else {
+        human(&mut stdout, report).context("cannot write to stdout")?;
+    }
+    Ok(())
+}
+
+fn human(w: &mut impl Write, r: &Value) -> std::io::Result<()> {
+    let maps = r["maps"].as_array().map(Vec::as_slice).unwrap_or(&[]);
+    let merged = maps.iter().filter(|m| m["merged"] == true).count();
+    let o = &r["output"];
+    if o.is_null() {
+        writeln!(w, "nothing merged: {}", r["reason"].as_str().unwrap_or("?"))?;
+    } else {
+        writeln!(
+            w,
+            "merged {merged} of {} maps into {} ({}, {} x {} cells at {} m/cell); report {}",
+            maps.len(),
+            o["yaml"].as_str().unwrap_or("?"),
+            o["image"].as_str().unwrap_or("?"),
+            o["width"],
+            o["height"],
+            o["resolution"],
+            o["report"].as_str().unwrap_or("?"),
+        )?;
+    }
+    for (k, m) in maps.iter().enumerate() {
+        let name = m["map"].as_str().unwrap_or("?");
+        if m["merged"] != true {
+            writeln!(
+                w,
+                "  {name}: not merged: {}",
+                m["reason"].as_str().unwrap_or("?")
+            )?;
+            continue;
+        }
+        let (t, wd) = (&m["transform"], &m["world"]);
+        let f = |v: &Value| v.as_f64().unwrap_or(f64::NAN);
+        writeln!(
+            w,
+            "  {name}{}: frame at x {:.3} m, y {:.3} m, yaw {:.3} deg (pixels: theta {:.3} deg, tx {:.2}, ty {:.2}), weight {}",
+            if k == 0 { " (reference)" } else { "" },
+            f(&wd["x"]),
+            f(&wd["y"]),
+            f(&wd["yaw"]).to_degrees(),
+            f(&t["theta"]).to_degrees(),
+            f(&t["tx"]),
+            f(&t["ty"]),
+            m["weight"],
+        )?;
+    }
+    for p in r["pairs"].as_array().map(Vec::as_slice).unwrap_or(&[]) {
+        let (a, b) = (
+            p["a"].as_str().unwrap_or("?"),
+            p["b"].as_str().unwrap_or("?"),
+        );
+        if p["accepted"] == true {
+            writeln!(
+                w,
+                "  pair {a} + {b}: accepted, confidence {:.2}, {} (residual {:.2} deg, {:.2} px)",
+                p["confidence"].as_f64().unwrap_or(0.0),
+                p["status"].as_str().unwrap_or("?"),
+                p["residual"]["rotation_deg"].as_f64().unwrap_or(0.0),
+                p["residual"]["translation_px"].as_f64().unwrap_or(0.0),
+            )?;
+        } else {
+            writeln!(
+                w,
+                "  pair {a} + {b}: declined: {}",
+                p["reason"].as_str().unwrap_or("?")
+            )?;
+        }
+    }
+    if !o.is_null() {
+        match r["acceptance_index"].as_f64() {
+            Some(ai) => writeln!(
+                w,
+                "acceptance index {ai:.3} over {} cells known in two maps or more",
+                r["overlap_cells"]
+            )?,
+            None => writeln!(w, "no cell is known in two maps")?,
+        }
+    }
+    writeln!(
+        w,
+        "{:.0} ms",
+        r["timings_ms"]["total"].as_f64().unwrap_or(0.0)
+    )
+}
+
+/// Colours of the maps' walls in the picture, by input order (cycled past eight maps).
+const PALETTE: [[u8; 3]; 8] = [
+    [40, 80, 230],
+    [230, 40, 40],
+    [20, 160, 60],
+    [240, 150, 20],
+    [150, 60, 200],
+    [20, 170, 190],
+    [200, 60, 150],
+    [130, 110, 40],
+];
+
+/// The merged map with each wall cell coloured by the maps that saw it.
+fn write_picture(path: &Path, fused: &FusedMap) -> anyhow::Result<()> {
+    let (w, h) = (fused.grid.width(), fused.grid.height());
+    let mut img = image::RgbImage::new(w as u32, h as u32);
+    for y in 0..h {
+        for x in 0..w {
+            let mut seen_by = fused
+                .layers
+                .iter()
+                .enumerate()
+                .filter(|(_, l)| l.state(x, y) == CellState::Occupied)
+                .map(|(k, _)| k);
+            let colour = match (seen_by.next(), seen_by.next()) {
+                (Some(_), Some(_)) => [0, 0, 0],
+                (Some(k), None) => PALETTE[k % PALETTE.len()],
+                _ => match fused.grid.state(x, y) {
+                    CellState::Free => [255, 255, 255],
+                    CellState::Occupied => [0, 0, 0],
+                    CellState::Unknown => [205, 205, 205],
+                },
+            };
+            img.put_pixel(x as u32, y as u32, image::Rgb(colour));
+        }
+    }
+    let mut png = Vec::new();
+    img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .map_err(|e| anyhow::anyhow!("{}: cannot encode the picture: {e}", path.display()))?;
+    write_atomic(path, &png).context("cannot write the picture")
+}

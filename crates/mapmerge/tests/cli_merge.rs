@@ -1,0 +1,318 @@
+//! `mapmerge merge` through the real binary: three turned crops of a real floor merged back into
+//! the floor, unrelated maps left out or refused, bad input refused with exit code 2, and
+//! nothing written but what a finished merge writes.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use grid_core::io::{LoadOptions, load_map, save_map};
+use grid_core::metrics::{agreement, displacement_error, rotation_error_deg};
+use grid_core::{CellState, DVec2, OccupancyGrid, Rigid2, UNKNOWN};
+use tempfile::TempDir;
+
+fn fixture(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../../fixtures/maps/{name}/{name}.yaml"))
+}
+
+fn merge(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_mapmerge"))
+        .arg("merge")
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+fn transform(v: &serde_json::Value) -> Rigid2 {
+    Rigid2::new(
+        v["theta"].as_f64().unwrap(),
+        v["tx"].as_f64().unwrap(),
+        v["ty"].as_f64().unwrap(),
+    )
+}
+
+/// The cells of `floor` that `keep(x, y)` selects (the rest unknown), placed by `floor_to_map`
+/// on a square canvas that holds any turn of the floor, saved as `name.yaml` in `dir`.
+fn crop(
+    dir: &TempDir,
+    name: &str,
+    floor: &OccupancyGrid,
+    keep: impl Fn(usize, usize) -> bool,
+    floor_to_map: Rigid2,
+) -> (PathBuf, OccupancyGrid) {
+    let mut c = floor.clone();
+    let w = floor.width();
+    for (i, cell) in c.cells_mut().iter_mut().enumerate() {
+        if !keep(i % w, i / w) {
+            *cell = UNKNOWN;
+        }
+    }
+    let (w, h) = (floor.width() as f64, floor.height() as f64);
+    let side = (w * w + h * h).sqrt() as usize + 20;
+    let map = c.warp(&floor_to_map, side, side).unwrap();
+    let path = dir.path().join(format!("{name}.yaml"));
+    save_map(&map, &path).unwrap();
+    (path, map)
+}
+
+/// A transform that turns the floor by `degrees` about its middle cell and puts that cell in
+/// the middle of the crop's canvas. Whole-cell shifts: unturned, the crop is the floor's cells
+/// moved, not resampled half a cell off.
+fn turned(floor: &OccupancyGrid, degrees: f64) -> Rigid2 {
+    let (w, h) = (floor.width() as f64, floor.height() as f64);
+    let side = (w * w + h * h).sqrt() as usize + 20;
+    let middle = DVec2::new((floor.width() / 2) as f64, (floor.height() / 2) as f64);
+    let to_origin = Rigid2::new(0.0, -middle.x, -middle.y);
+    let half = (side / 2) as f64;
+    Rigid2::new(degrees.to_radians(), half, half).compose(&to_origin)
+}
+
+#[test]
+fn three_turned_crops_of_a_real_floor_merge_back_into_the_floor() {
+    let dir = TempDir::new().unwrap();
+    let floor = load_map(fixture("intel_lab"), &LoadOptions::default()).unwrap();
+    let (w, h) = (floor.width(), floor.height());
+    // West 60 %, east 60 % turned by 30 degrees, north 60 % turned by -100 degrees: every
+    // cell of the floor is in at least one crop, and each pair shares a third of the floor.
+    let to = [
+        turned(&floor, 0.0),
+        turned(&floor, 30.0),
+        turned(&floor, -100.0),
+    ];
+    let (a, ga) = crop(&dir, "west", &floor, |x, _| x < w * 6 / 10, to[0]);
+    let (b, gb) = crop(&dir, "east", &floor, |x, _| x >= w * 4 / 10, to[1]);
+    let (c, gc) = crop(&dir, "north", &floor, |_, y| y < h * 6 / 10, to[2]);
+    let out = dir.path().join("team.yaml");
+    let png = dir.path().join("team.png");
+    let o = merge(&[
+        s(&a),
+        s(&b),
+        s(&c),
+        "-o",
+        s(&out),
+        "--json",
+        "--debug-png",
+        s(&png),
+    ]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{stderr}");
+    assert!(stderr.is_empty(), "no warning: {stderr}");
+    let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    // The report on disk is the one printed.
+    let on_disk: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.with_extension("json")).unwrap()).unwrap();
+    assert_eq!(report, on_disk);
+    let maps = report["maps"].as_array().unwrap();
+    assert!(maps.iter().all(|m| m["merged"] == true), "{report}");
+    let pairs = report["pairs"].as_array().unwrap();
+    assert_eq!(pairs.len(), 3);
+    assert!(pairs.iter().all(|p| p["accepted"] == true), "{report}");
+
+    // Each map's pose, against the truth: map k's pixel -> floor -> west crop -> merged map,
+    // the last step being the reference's own pose in the report.
+    let pose = |k: usize| transform(&maps[k]["transform"]);
+    let reference = pose(0);
+    assert_eq!(reference.theta, 0.0, "the reference is only shifted");
+    for (k, g) in [(1, &gb), (2, &gc)] {
+        let truth = reference.compose(&to[0]).compose(&to[k].inverse());
+        let disp = displacement_error(g, &pose(k), &truth).unwrap();
+        let rot = rotation_error_deg(&pose(k), &truth);
+        assert!(disp < 0.5, "map {k}: {disp} px off ({rot} degrees)");
+        assert!(rot < 0.1, "map {k}: {rot} degrees off");
+    }
+
+    // The merged map, read back, is the floor: its cells agree with the floor's, it covers
+    // nearly all of them, and a point has the same world coordinates in it as in the west crop.
+    let merged = load_map(&out, &LoadOptions::default()).unwrap();
+    let floor_to_merged = reference.compose(&to[0]);
+    let ag = agreement(&merged, &floor, &floor_to_merged);
+    let ai = ag.acceptance_index().unwrap();
+    assert!(ai > 0.97, "acceptance index {ai}");
+    let known = floor.counts().free + floor.counts().occupied;
+    assert!(
+        ag.overlap() as f64 > 0.97 * known as f64,
+        "{} of {known} floor cells covered",
+        ag.overlap()
+    );
+    let p = DVec2::new(200.0, 300.0);
+    let q = merged.world_to_pixel(ga.pixel_to_world(p));
+    assert!((q - reference.apply(p)).length() < 1e-6, "{q}");
+    assert_eq!(report["output"]["width"], merged.width());
+    let ai_report = report["acceptance_index"].as_f64().unwrap();
+    assert!(ai_report > 0.9, "{ai_report}");
+    let img = image::open(&png).unwrap();
+    assert_eq!(
+        (img.width() as usize, img.height() as usize),
+        (merged.width(), merged.height())
+    );
+}
+
+#[test]
+fn a_map_that_overlaps_no_other_is_left_out_or_nothing_is_written() {
+    let dir = TempDir::new().unwrap();
+    let floor = load_map(fixture("wpi_ilab"), &LoadOptions::default()).unwrap();
+    let other = load_map(fixture("aws_small_house"), &LoadOptions::default()).unwrap();
+    let w = floor.width();
+    let (a, _) = crop(&dir, "a", &floor, |x, _| x < w * 3 / 4, turned(&floor, 0.0));
+    let (b, _) = crop(&dir, "b", &floor, |x, _| x >= w / 4, turned(&floor, 30.0));
+    let (c, _) = crop(&dir, "c", &other, |_, _| true, turned(&other, 0.0));
+
+    // Two of three: merged, with a warning naming the third.
+    let out = dir.path().join("ab.yaml");
+    let o = merge(&[s(&a), s(&b), s(&c), "-o", s(&out), "--json"]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{stderr}");
+    assert_eq!(
+        stderr.trim_end(),
+        format!(
+            "mapmerge: warning: {}: not merged: no accepted pair links it to {}",
+            c.display(),
+            a.display()
+        )
+    );
+    let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let merged: Vec<bool> = report["maps"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| m["merged"].as_bool().unwrap())
+        .collect();
+    assert_eq!(merged, [true, true, false]);
+    assert!(report["maps"][2]["transform"].is_null());
+    assert!(out.exists() && out.with_extension("pgm").exists());
+
+    // The first map overlaps none: exit 3, and nothing is written.
+    let out = dir.path().join("none.yaml");
+    let o = merge(&[s(&c), s(&a), "-o", s(&out), "--json"]);
+    assert_eq!(o.status.code(), Some(3));
+    let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(report["output"].is_null());
+    assert!(
+        report["reason"]
+            .as_str()
+            .unwrap()
+            .contains("no map could be placed"),
+        "{report}"
+    );
+    let left: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .filter(|n| n.starts_with("none") || n.starts_with(".none"))
+        .collect();
+    assert!(left.is_empty(), "{left:?}");
+}
+
+fn fails(args: &[&str]) -> String {
+    let out = merge(args);
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+    assert!(out.stdout.is_empty());
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    stderr.trim_end().to_string()
+}
+
+#[test]
+fn bad_input_is_refused_with_exit_2_and_inputs_are_never_overwritten() {
+    let dir = TempDir::new().unwrap();
+    // Copies, so that a failure cannot spoil the fixtures.
+    let a = dir.path().join("wpi_ilab.yaml");
+    let image = dir.path().join("wpi_ilab.pgm");
+    std::fs::copy(fixture("wpi_ilab"), &a).unwrap();
+    std::fs::copy(fixture("wpi_ilab").with_extension("pgm"), &image).unwrap();
+    let before = (std::fs::read(&a).unwrap(), std::fs::read(&image).unwrap());
+    let a_s = s(&a);
+    let out = dir.path().join("out.yaml");
+    let out_s = s(&out);
+
+    let err = fails(&[a_s, "-o", out_s]);
+    assert!(err.contains("MAP"), "{err}");
+    let err = fails(&[a_s, a_s, "-o", a_s]);
+    assert_eq!(
+        err,
+        format!(
+            "mapmerge: error: {a_s}: --output would overwrite an input map; choose another file"
+        )
+    );
+    // The output's PGM would be the image an input YAML names.
+    let err = fails(&[a_s, a_s, "-o", s(&dir.path().join("wpi_ilab.yml"))]);
+    assert_eq!(
+        err,
+        format!(
+            "mapmerge: error: {}: --output's PGM would overwrite an input map; choose another file",
+            image.display()
+        )
+    );
+    let err = fails(&[a_s, a_s, "-o", s(&dir.path().join("out.pgm"))]);
+    assert!(err.contains("must be a .yaml or .yml file"), "{err}");
+    let nowhere = dir.path().join("no_such_dir").join("out.yaml");
+    let err = fails(&[a_s, a_s, "-o", s(&nowhere)]);
+    assert!(err.contains("does not exist"), "{err}");
+    let err = fails(&[a_s, a_s, "-o", out_s, "--weights", "1,NaN"]);
+    assert!(
+        err.contains("must be a finite number greater than 0"),
+        "{err}"
+    );
+    let err = fails(&[a_s, a_s, "-o", out_s, "--weights", "1,2,3"]);
+    assert!(err.contains("--weights gives 3 values for 2 maps"), "{err}");
+    let err = fails(&[a_s, a_s, "-o", out_s, "--rule", "max"]);
+    assert!(err.contains("unknown fusion rule `max`"), "{err}");
+    let err = fails(&[a_s, a_s, "-o", out_s, "--debug-png", out_s]);
+    assert!(
+        err.contains("--debug-png names one of the merged map's own files"),
+        "{err}"
+    );
+    let err = fails(&[a_s, s(&fixture("intel_lab")), "-o", out_s]);
+    assert!(err.contains("resolution 0.1 m/cell differs"), "{err}");
+    let missing = dir.path().join("nope.yaml");
+    let err = fails(&[a_s, s(&missing), "-o", out_s]);
+    assert!(
+        err.starts_with(&format!("mapmerge: error: {}: ", missing.display())),
+        "{err}"
+    );
+    let blank = OccupancyGrid::new(20, 10, 0.05, Default::default()).unwrap();
+    let blank_path = dir.path().join("blank.yaml");
+    save_map(&blank, &blank_path).unwrap();
+    let err = fails(&[a_s, s(&blank_path), "-o", out_s]);
+    assert!(err.contains("every cell is unknown"), "{err}");
+
+    assert_eq!(
+        (std::fs::read(&a).unwrap(), std::fs::read(&image).unwrap()),
+        before
+    );
+    assert!(!out.exists());
+}
+
+#[test]
+fn a_map_merged_with_itself_is_itself() {
+    let dir = TempDir::new().unwrap();
+    let floor = load_map(fixture("wpi_ilab"), &LoadOptions::default()).unwrap();
+    let out = dir.path().join("twice.yaml");
+    let f = s(&fixture("wpi_ilab")).to_string();
+    let o = merge(&[&f, &f, "-o", s(&out), "--json"]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let merged = load_map(&out, &LoadOptions::default()).unwrap();
+    let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let (x0, y0) = (
+        -report["maps"][0]["transform"]["tx"].as_f64().unwrap(),
+        -report["maps"][0]["transform"]["ty"].as_f64().unwrap(),
+    );
+    // Every known cell of the floor, exactly, at its place (the two copies agree everywhere).
+    for y in 0..floor.height() {
+        for x in 0..floor.width() {
+            let (u, v) = (x as f64 - x0, y as f64 - y0);
+            let got = merged.state(u as usize, v as usize);
+            if floor.state(x, y) != CellState::Unknown {
+                assert_eq!(got, floor.state(x, y), "({x}, {y})");
+            }
+        }
+    }
+    assert_eq!(report["acceptance_index"], 1.0);
+}
