@@ -8,6 +8,7 @@ mod eval;
 mod r#gen;
 mod picture;
 mod regress;
+mod team;
 
 /// mapmerge project tasks.
 #[derive(Parser)]
@@ -28,6 +29,8 @@ enum Command {
     Compare(compare::Args),
     /// Run the regression batch of eval sets into a directory (for `compare`).
     Regress(regress::Args),
+    /// Measure how well `mapmerge merge` places every map of simulated robot teams.
+    Team(team::Args),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -36,5 +39,6 @@ fn main() -> anyhow::Result<()> {
         Command::Eval(args) => eval::run(*args),
         Command::Compare(args) => compare::run(args),
         Command::Regress(args) => regress::run(args),
+        Command::Team(args) => team::run(args),
     }
 }

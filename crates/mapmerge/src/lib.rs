@@ -11,6 +11,7 @@ pub mod global;
 pub mod refine;
 mod register;
 pub mod search;
+pub mod team;
 pub mod verify;
 
 #[cfg(test)]

@@ -8,14 +8,11 @@ use std::time::Instant;
 
 use anyhow::Context;
 use clap::Args;
-use fusion::{
-    EdgeStatus, FusedMap, FusionConfig, FusionRule, MapPlacement, PairEdge, PoseGraphConfig,
-    solve_poses,
-};
+use fusion::{EdgeStatus, FusedMap, FusionConfig, FusionRule};
 use grid_core::io::{LoadedMap, image_path_for, save_map, write_atomic};
-use grid_core::{CellState, DVec2, OccupancyGrid, Rigid2};
-use mapmerge::{Method, RegisterConfig, Registration, register};
-use rayon::prelude::*;
+use grid_core::{CellState, OccupancyGrid, Rigid2};
+use mapmerge::team::{TeamConfig, TeamPair, merge_team};
+use mapmerge::{Method, RegisterConfig};
 use serde_json::{Value, json};
 
 use super::{BareImageArgs, UsageError, load, refuse_overwriting, require_directory};
@@ -177,41 +174,42 @@ pub fn run(args: &MergeArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode> {
         refuse_overwriting(out, flag, maps.iter().map(|m| &m.image_path))?;
     }
 
-    let mut config = RegisterConfig {
-        method: args.method,
-        ..RegisterConfig::default()
+    let mut team = TeamConfig {
+        register: RegisterConfig {
+            method: args.method,
+            ..RegisterConfig::default()
+        },
+        fusion: FusionConfig {
+            rule: args.rule,
+            ..FusionConfig::default()
+        },
+        ..TeamConfig::default()
     };
-    config.pair.ransac.seed = args.seed;
-    let t_register = Instant::now();
-    let pairs = register_pairs(&maps, &config)?;
-    let register_ms = t_register.elapsed().as_secs_f64() * 1e3;
-
-    let edges: Vec<PairEdge> = pairs
-        .iter()
-        .filter_map(|p| {
-            p.registration.accepted.as_ref().map(|c| PairEdge {
-                a: p.a,
-                b: p.b,
-                b_to_a: c.transform,
-                weight: c.verification.wall_lift.clamp(0.01, 1.0),
-            })
-        })
-        .collect();
-    let centres: Vec<DVec2> = maps.iter().map(|m| known_centre(&m.grid)).collect();
-    let solution = solve_poses(&centres, 0, &edges, &PoseGraphConfig::default())
-        .context("solving the maps' poses")?;
-    // Each accepted pair's edge, by pair index.
-    let mut edge_of = vec![None; pairs.len()];
-    let mut next = 0;
-    for (i, p) in pairs.iter().enumerate() {
-        if p.registration.accepted.is_some() {
-            edge_of[i] = Some(next);
-            next += 1;
+    team.register.pair.ransac.seed = args.seed;
+    let grids: Vec<&OccupancyGrid> = maps.iter().map(|m| &m.grid).collect();
+    let n_pairs = grids.len() * (grids.len() - 1) / 2;
+    // Drawn on stderr, and only when it is a terminal: scripts and pipes see nothing.
+    let bar = indicatif::ProgressBar::new(n_pairs as u64).with_style(
+        indicatif::ProgressStyle::with_template(
+            "registering pairs [{bar:30}] {pos}/{len} ({elapsed})",
+        )
+        .expect("a valid template")
+        .progress_chars("=> "),
+    );
+    let merged = merge_team(&grids, &weights, &team, &|| bar.inc(1));
+    bar.finish_and_clear();
+    let merged = match merged {
+        Ok(m) => m,
+        Err(mapmerge::team::Error::Fusion(e)) => {
+            return Err(UsageError(format!(
+                "{}: cannot merge the maps: {e}",
+                args.output.display()
+            ))
+            .into());
         }
-    }
-    let reached: Vec<usize> = (0..maps.len())
-        .filter(|&k| solution.poses[k].is_some())
-        .collect();
+        Err(e) => return Err(anyhow::Error::from(e).context("cannot merge the maps")),
+    };
+    let solution = &merged.poses;
 
     let mut report = json!({
         "reference": args.maps[0].display().to_string(),
@@ -221,8 +219,8 @@ pub fn run(args: &MergeArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode> {
         },
         "method": args.method,
         "seed": args.seed,
-        "pairs": pairs.iter().enumerate().map(|(i, p)| {
-            pair_report(&args.maps, p, edge_of[i].map(|e| (solution.status[e], solution.residuals[e])))
+        "pairs": merged.pairs.iter().map(|p| {
+            pair_report(&args.maps, p, p.edge.map(|e| (solution.status[e], solution.residuals[e])))
         }).collect::<Vec<_>>(),
     });
     let mut map_reports: Vec<Value> = args
@@ -241,43 +239,20 @@ pub fn run(args: &MergeArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode> {
         })
         .collect();
 
-    if reached.len() < 2 {
+    let Some(fused) = &merged.fused else {
         report["output"] = Value::Null;
         report["reason"] = json!(format!(
             "no map could be placed in {}'s frame: every pair with it was declined",
             args.maps[0].display()
         ));
         report["maps"] = json!(map_reports);
-        report["timings_ms"] =
-            json!({"register": register_ms, "total": start.elapsed().as_secs_f64() * 1e3});
+        report["timings_ms"] = json!({"total": start.elapsed().as_secs_f64() * 1e3});
         print_report(args, &report)?;
         return Ok(ExitCode::from(3));
-    }
-
-    let t_fuse = Instant::now();
-    let placements: Vec<MapPlacement<'_>> = reached
-        .iter()
-        .map(|&k| MapPlacement {
-            grid: &maps[k].grid,
-            pose: solution.poses[k].expect("reached"),
-            weight: weights[k],
-        })
-        .collect();
-    let fusion_config = FusionConfig {
-        rule: args.rule,
-        ..FusionConfig::default()
     };
-    let fused =
-        fusion::fuse(&maps[0].grid.geometry(), &placements, &fusion_config).map_err(|e| {
-            UsageError(format!(
-                "{}: cannot fuse the maps: {e}",
-                args.output.display()
-            ))
-        })?;
-    let fuse_ms = t_fuse.elapsed().as_secs_f64() * 1e3;
 
     let out_geometry = fused.grid.geometry();
-    for (slot, &k) in reached.iter().enumerate() {
+    for (slot, &k) in merged.placed.iter().enumerate() {
         let pose = fused.poses[slot];
         let world = pose.to_world(&out_geometry, &maps[k].grid.geometry());
         map_reports[k] = json!({
@@ -305,15 +280,11 @@ pub fn run(args: &MergeArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode> {
     report["maps"] = json!(map_reports);
     report["acceptance_index"] = json!(fused.agreement.acceptance_index());
     report["overlap_cells"] = json!(fused.overlap_cells);
-    report["timings_ms"] = json!({
-        "register": register_ms,
-        "fuse": fuse_ms,
-        "total": start.elapsed().as_secs_f64() * 1e3,
-    });
+    report["timings_ms"] = json!({"total": start.elapsed().as_secs_f64() * 1e3});
 
-    write_outputs(&outputs, &fused, &report)?;
+    write_outputs(&outputs, fused, &report)?;
     if let Some(png) = &args.debug_png {
-        write_picture(png, &fused)?;
+        write_picture(png, fused)?;
     }
     for (k, r) in map_reports.iter().enumerate() {
         if r["merged"] == false {
@@ -354,65 +325,13 @@ fn load_all(paths: &[PathBuf], bare: &BareImageArgs) -> anyhow::Result<Vec<Loade
     Ok(maps)
 }
 
-/// One registered pair: `b` onto `a`, `a < b`.
-struct Pair {
-    a: usize,
-    b: usize,
-    registration: Registration,
-}
-
-/// Register every pair `a < b` in parallel, with a progress bar on a terminal.
-fn register_pairs(maps: &[LoadedMap], config: &RegisterConfig) -> anyhow::Result<Vec<Pair>> {
-    let n = maps.len();
-    let indices: Vec<(usize, usize)> = (0..n)
-        .flat_map(|a| (a + 1..n).map(move |b| (a, b)))
-        .collect();
-    // Drawn on stderr, and only when it is a terminal: scripts and pipes see nothing.
-    let bar = indicatif::ProgressBar::new(indices.len() as u64).with_style(
-        indicatif::ProgressStyle::with_template(
-            "registering pairs [{bar:30}] {pos}/{len} ({elapsed})",
-        )
-        .expect("a valid template")
-        .progress_chars("=> "),
-    );
-    let pairs = indices
-        .par_iter()
-        .map(|&(a, b)| {
-            let registration = register(&maps[a].grid, &maps[b].grid, config)
-                .context("invalid registration settings")?;
-            bar.inc(1);
-            Ok(Pair { a, b, registration })
-        })
-        .collect::<anyhow::Result<Vec<_>>>();
-    bar.finish_and_clear();
-    pairs
-}
-
-/// The mean pixel of a map's known cells (the maps are checked to have some).
-fn known_centre(g: &OccupancyGrid) -> DVec2 {
-    let (mut sum, mut n) = (DVec2::ZERO, 0usize);
-    for y in 0..g.height() {
-        for x in 0..g.width() {
-            if g.state(x, y) != CellState::Unknown {
-                sum += DVec2::new(x as f64, y as f64);
-                n += 1;
-            }
-        }
-    }
-    if n == 0 {
-        DVec2::new(g.width() as f64, g.height() as f64) * 0.5
-    } else {
-        sum / n as f64
-    }
-}
-
 fn transform_json(t: &Rigid2) -> Value {
     json!({"theta": t.theta, "tx": t.tx, "ty": t.ty})
 }
 
 fn pair_report(
     paths: &[PathBuf],
-    p: &Pair,
+    p: &TeamPair,
     edge: Option<(EdgeStatus, fusion::EdgeResidual)>,
 ) -> Value {
     let r = &p.registration;

@@ -1,0 +1,176 @@
+//! A robot team's maps merged into one: every pair registered ([`crate::register`]), one pose
+//! per map from the accepted pairs ([`fusion::solve_poses`]), then the placed maps fused
+//! ([`fusion::fuse`]).
+
+use fusion::{
+    FusedMap, FusionConfig, FusionError, MapPlacement, PairEdge, PoseGraphConfig, PoseGraphSolution,
+};
+use grid_core::{CellState, DVec2, OccupancyGrid};
+use rayon::prelude::*;
+
+use crate::{RegisterConfig, Registration, register};
+
+/// What can go wrong when merging a team (the maps themselves are the caller's to check: each
+/// needs known cells, all the same resolution).
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// The registration settings are invalid.
+    #[error("invalid registration settings: {0}")]
+    Config(#[from] sift_desc::Error),
+    /// Fusing the maps or solving their poses failed.
+    #[error(transparent)]
+    Fusion(#[from] FusionError),
+    /// `weights` does not give one weight per map, or the reference is not a map.
+    #[error("{0}")]
+    Input(String),
+}
+
+/// Settings of [`merge_team`].
+#[derive(Debug, Clone, Default)]
+pub struct TeamConfig {
+    /// How each pair is registered; default [`RegisterConfig::default`].
+    pub register: RegisterConfig,
+    /// How the poses are solved from the accepted pairs; default
+    /// [`PoseGraphConfig::default`] (a tree of the most confident answers, loop answers within
+    /// 3 degrees and 8 px of it refine the poses by least squares).
+    pub poses: PoseGraphConfig,
+    /// How the placed maps are fused; default [`FusionConfig::default`] (the paper's weighted
+    /// mean).
+    pub fusion: FusionConfig,
+    /// The map whose frame the result is in; default 0, the first.
+    pub reference: usize,
+}
+
+/// One registered pair: map `b` onto map `a`, `a < b`.
+#[derive(Debug, Clone)]
+pub struct TeamPair {
+    /// The map the answer is in.
+    pub a: usize,
+    /// The map placed into `a`.
+    pub b: usize,
+    /// The registration.
+    pub registration: Registration,
+    /// For an accepted pair, its index among the pose graph's edges (in
+    /// [`PoseGraphSolution::status`] and [`PoseGraphSolution::residuals`]).
+    pub edge: Option<usize>,
+}
+
+/// The result of [`merge_team`].
+#[derive(Debug, Clone)]
+pub struct TeamMerge {
+    /// Every pair `a < b`, in order (`(0, 1), (0, 2), ..., (1, 2), ...`).
+    pub pairs: Vec<TeamPair>,
+    /// One pose per map, each map's pixels onto the reference's; `None` for a map that no
+    /// accepted pair links to the reference.
+    pub poses: PoseGraphSolution,
+    /// The maps with a pose, in index order: the inputs of the fusion, whose
+    /// [`FusedMap::poses`] and [`FusedMap::layers`] follow this order.
+    pub placed: Vec<usize>,
+    /// The placed maps fused in the reference's frame (shifted by whole cells); `None` when no
+    /// map but the reference could be placed.
+    pub fused: Option<FusedMap>,
+}
+
+/// The mean pixel of a map's known cells (the middle of the grid when none is known): where
+/// the pose graph measures how far apart two answers put the map.
+pub fn known_centre(g: &OccupancyGrid) -> DVec2 {
+    let (mut sum, mut n) = (DVec2::ZERO, 0usize);
+    for y in 0..g.height() {
+        for x in 0..g.width() {
+            if g.state(x, y) != CellState::Unknown {
+                sum += DVec2::new(x as f64, y as f64);
+                n += 1;
+            }
+        }
+    }
+    if n == 0 {
+        DVec2::new(g.width() as f64, g.height() as f64) * 0.5
+    } else {
+        sum / n as f64
+    }
+}
+
+/// Merge a team's `maps`, weighted by `weights` (each map's reliability, one per map): register
+/// every pair `a < b` in parallel (`on_pair` is called after each, for a progress bar), solve
+/// one pose per map in the frame of map [`TeamConfig::reference`] with the accepted pairs'
+/// wall lifts as confidences, and fuse the maps that got a pose.
+///
+/// The same maps and settings give the same result, whatever the thread count.
+pub fn merge_team(
+    maps: &[&OccupancyGrid],
+    weights: &[f64],
+    config: &TeamConfig,
+    on_pair: &(dyn Fn() + Sync),
+) -> Result<TeamMerge, Error> {
+    if weights.len() != maps.len() {
+        return Err(Error::Input(format!(
+            "{} weights for {} maps: give one per map",
+            weights.len(),
+            maps.len()
+        )));
+    }
+    if config.reference >= maps.len() {
+        return Err(Error::Input(format!(
+            "the reference map {} is not one of the {} maps",
+            config.reference,
+            maps.len()
+        )));
+    }
+    let n = maps.len();
+    let indices: Vec<(usize, usize)> = (0..n)
+        .flat_map(|a| (a + 1..n).map(move |b| (a, b)))
+        .collect();
+    let registrations = indices
+        .par_iter()
+        .map(|&(a, b)| {
+            let r = register(maps[a], maps[b], &config.register);
+            on_pair();
+            r
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut edges = Vec::new();
+    let mut pairs = Vec::with_capacity(indices.len());
+    for (&(a, b), registration) in indices.iter().zip(registrations) {
+        let edge = registration.accepted.as_ref().map(|c| {
+            edges.push(PairEdge {
+                a,
+                b,
+                b_to_a: c.transform,
+                weight: c.verification.wall_lift.clamp(0.01, 1.0),
+            });
+            edges.len() - 1
+        });
+        pairs.push(TeamPair {
+            a,
+            b,
+            registration,
+            edge,
+        });
+    }
+    let centres: Vec<DVec2> = maps.iter().map(|m| known_centre(m)).collect();
+    let poses = fusion::solve_poses(&centres, config.reference, &edges, &config.poses)?;
+    let placed: Vec<usize> = (0..n).filter(|&k| poses.poses[k].is_some()).collect();
+    let fused = if placed.len() < 2 {
+        None
+    } else {
+        let placements: Vec<MapPlacement<'_>> = placed
+            .iter()
+            .map(|&k| MapPlacement {
+                grid: maps[k],
+                pose: poses.poses[k].expect("placed"),
+                weight: weights[k],
+            })
+            .collect();
+        Some(fusion::fuse(
+            &maps[config.reference].geometry(),
+            &placements,
+            &config.fusion,
+        )?)
+    };
+    Ok(TeamMerge {
+        pairs,
+        poses,
+        placed,
+        fused,
+    })
+}
