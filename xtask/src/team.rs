@@ -23,7 +23,9 @@ pub struct Args {
     /// Cases per row
     #[arg(long, default_value_t = 10)]
     pub cases: usize,
-    /// Seed of the first case (case k of row r uses seed * 1000000 + r * 1000 + k)
+    /// Seed of the first case (case k of the team of n robots in world w, 0 disaster or 1
+    /// indoor, uses seed * 1000000 + (10 w + n) * 1000 + k: a row's cases do not depend on
+    /// which other rows run)
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Overlap of consecutive robots' explored areas, as a fraction of the smaller
@@ -38,6 +40,34 @@ pub struct Args {
     /// Use the spanning tree's poses only, without the least-squares refinement over loops
     #[arg(long)]
     pub no_refine: bool,
+    /// After the table, list every map not placed within 3 px, with each pair's outcome: its
+    /// error against the truth and what the pose graph made of it
+    #[arg(long)]
+    pub list: bool,
+}
+
+/// Overlap (of the smaller map) from which a pair counts as linking two maps in the truth.
+const LINKED_OVERLAP: f64 = 0.15;
+
+/// Per map, whether a chain of pairs overlapping by [`LINKED_OVERLAP`] or more links it to map
+/// 0.
+fn linked_to_first(overlaps: &[Vec<f64>]) -> Vec<bool> {
+    let n = overlaps.len();
+    let mut linked = vec![false; n];
+    linked[0] = true;
+    let mut grew = true;
+    while grew {
+        grew = false;
+        for a in 0..n {
+            for b in 0..n {
+                if linked[a] && !linked[b] && overlaps[a][b] >= LINKED_OVERLAP {
+                    linked[b] = true;
+                    grew = true;
+                }
+            }
+        }
+    }
+    linked
 }
 
 /// Counts of one row.
@@ -47,6 +77,9 @@ struct Tally {
     failed_to_generate: usize,
     /// Maps other than the first, over the generated cases.
     maps: usize,
+    /// Of those, the maps the truth links to the first by a chain of pairs that overlap by
+    /// [`LINKED_OVERLAP`] or more: the most any merge can place.
+    linked: usize,
     /// Of those, placed by the pose graph / within 3 px / more than 3 px off.
     placed: usize,
     right: usize,
@@ -80,12 +113,14 @@ pub fn run(args: Args) -> Result<()> {
         "--overlap is a fraction in [0, 1]"
     );
     let mut rows = Vec::new();
-    for (kind_name, kind) in [
+    let worlds = [
         ("disaster", WorldKind::Disaster),
         ("indoor", WorldKind::Indoor),
-    ] {
+    ];
+    for (w, (kind_name, kind)) in worlds.into_iter().enumerate() {
         for &n in &args.robots {
-            rows.push((format!("{kind_name}, {n} robots"), kind.clone(), n));
+            let label = format!("{kind_name}, {n} robots");
+            rows.push((label, kind.clone(), n, 10 * w + n));
         }
     }
     let bar = ProgressBar::new((rows.len() * args.cases) as u64);
@@ -97,13 +132,14 @@ pub fn run(args: Args) -> Result<()> {
     let mut config = TeamConfig::default();
     config.poses.refine = !args.no_refine;
     let mut out = String::new();
+    let mut listing = String::new();
     out.push_str(
-        "| team | cases | maps placed | within 3 px | placed > 3 px off | teams all within 3 px | star: within 3 px | star: placed > 3 px off | star: teams all within 3 px | median error (px) | mean time (ms) |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| team | cases | maps linked to the first in the truth | maps placed | within 3 px | placed > 3 px off | teams all within 3 px | star: within 3 px | star: placed > 3 px off | star: teams all within 3 px | median error (px) | mean time (ms) |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
-    for (r, (label, kind, n)) in rows.iter().enumerate() {
+    for (label, kind, n, row_id) in &rows {
         let mut t = Tally::default();
         for k in 0..args.cases {
-            let seed = args.seed * 1_000_000 + r as u64 * 1000 + k as u64;
+            let seed = args.seed * 1_000_000 + *row_id as u64 * 1000 + k as u64;
             let case_config = CaseConfig {
                 world: WorldConfig {
                     kind: kind.clone(),
@@ -131,6 +167,10 @@ pub fn run(args: Args) -> Result<()> {
                 displacement_error(grids[j], pose, &case.truth(0, j)).unwrap_or(f64::INFINITY)
             };
             let (mut all, mut star_all) = (true, true);
+            t.linked += linked_to_first(&case.overlaps)[1..]
+                .iter()
+                .filter(|&&l| l)
+                .count();
             for j in 1..*n {
                 t.maps += 1;
                 match merged.poses.poses[j] {
@@ -166,6 +206,33 @@ pub fn run(args: Args) -> Result<()> {
                     None => star_all = false,
                 }
             }
+            if args.list && !all {
+                listing.push_str(&format!("{label}, case {seed}:"));
+                for j in 1..*n {
+                    let e = merged.poses.poses[j].map(|p| error(j, &p));
+                    listing.push_str(&format!(
+                        " map {j} {};",
+                        e.map_or("not placed".into(), |e| format!("{e:.2} px"))
+                    ));
+                }
+                listing.push('\n');
+                for p in &merged.pairs {
+                    let what = match (&p.registration.accepted, p.edge) {
+                        (Some(c), Some(e)) => format!(
+                            "{:?}, lift {:.2}, {:.2} px off",
+                            merged.poses.status[e],
+                            c.verification.wall_lift,
+                            displacement_error(grids[p.b], &c.transform, &case.truth(p.a, p.b))
+                                .unwrap_or(f64::INFINITY)
+                        ),
+                        _ => "declined".into(),
+                    };
+                    listing.push_str(&format!(
+                        "    pair ({}, {}), overlap {:.2}: {what}\n",
+                        p.a, p.b, case.overlaps[p.a][p.b]
+                    ));
+                }
+            }
             t.all_right += usize::from(all);
             t.star_all_right += usize::from(star_all);
         }
@@ -180,8 +247,9 @@ pub fn run(args: Args) -> Result<()> {
             t.cases.to_string()
         };
         out.push_str(&format!(
-            "| {label}, overlap {} | {cases} | {} | {} | {} | {} | {} | {} | {} | {median} | {:.0} |\n",
+            "| {label}, overlap {} | {cases} | {} | {} | {} | {} | {} | {} | {} | {} | {median} | {:.0} |\n",
             args.overlap,
+            pct(t.linked, t.maps),
             pct(t.placed, t.maps),
             pct(t.right, t.maps),
             pct(t.wrong, t.maps),
@@ -193,6 +261,6 @@ pub fn run(args: Args) -> Result<()> {
         ));
     }
     bar.finish_and_clear();
-    print!("{out}");
+    print!("{out}{listing}");
     Ok(())
 }

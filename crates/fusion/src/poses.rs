@@ -460,15 +460,28 @@ mod tests {
     }
 
     proptest! {
-        /// Answers between every pair of up to six maps, each up to 1 px and 0.3 degrees off:
-        /// every map's centre lands within 2 px of where the truth puts it.
+        // A fixed seed, so that CI runs the same cases every time.
+        #![proptest_config(ProptestConfig {
+            rng_seed: proptest::test_runner::RngSeed::Fixed(7),
+            ..ProptestConfig::default()
+        })]
+
+        /// Answers between every pair of up to six maps that overlap (centres within about
+        /// 200 px of each other), each up to 1 px and 0.3 degrees off about the placed map's
+        /// centre: every map's centre lands within 2 px of where the truth puts it, and no
+        /// answer is dropped.
         #[test]
         fn noisy_answers_between_every_pair_give_poses_near_the_truth(
             n in 2usize..7,
-            seed_poses in proptest::collection::vec((-3.1f64..3.1, -300.0f64..300.0, -300.0f64..300.0), 6),
+            seed_poses in proptest::collection::vec((-3.1f64..3.1, -100.0f64..100.0, -100.0f64..100.0), 6),
             noise in proptest::collection::vec((-0.3f64..0.3, -0.7f64..0.7, -0.7f64..0.7), 15),
         ) {
-            let mut t: Vec<Rigid2> = seed_poses[..n].iter().map(|&(a, x, y)| Rigid2::new(a, x, y)).collect();
+            // Each map turned about its centre, the centre moved by up to 100 px each way.
+            let c = DVec2::new(100.0, 80.0);
+            let mut t: Vec<Rigid2> = seed_poses[..n]
+                .iter()
+                .map(|&(a, x, y)| Rigid2::new(0.0, x, y).compose(&Rigid2::rotation_about(a, c)))
+                .collect();
             t[0] = Rigid2::IDENTITY;
             let mut edges = Vec::new();
             for a in 0..n {
