@@ -90,10 +90,20 @@ pub fn known_centre(g: &OccupancyGrid) -> DVec2 {
     }
 }
 
+/// How much the pose graph trusts an accepted answer: the wall cells that agree (compared
+/// both ways), discounted by the wall lift. An answer's precision grows with the walls it
+/// rests on, so a small overlap's answer, even one that fits well, counts for less than a
+/// large overlap's: the spanning tree prefers the large overlaps, and a small overlap's loop
+/// answer pulls the refined poses little.
+fn edge_weight(v: &crate::verify::Verification) -> f64 {
+    let agreeing = v.wall_support as f64 * v.wall_agreement.clamp(0.0, 1.0);
+    (agreeing * v.wall_lift.clamp(0.0, 1.0)).max(1e-3)
+}
+
 /// Merge a team's `maps`, weighted by `weights` (each map's reliability, one per map): register
 /// every pair `a < b` in parallel (`on_pair` is called after each, for a progress bar), solve
-/// one pose per map in the frame of map [`TeamConfig::reference`] with the accepted pairs'
-/// wall lifts as confidences, and fuse the maps that got a pose.
+/// one pose per map in the frame of map [`TeamConfig::reference`] from the accepted pairs
+/// (weighted by the walls they agree on, [`edge_weight`]), and fuse the maps that got a pose.
 ///
 /// The same maps and settings give the same result, whatever the thread count.
 pub fn merge_team(
@@ -136,7 +146,7 @@ pub fn merge_team(
                 a,
                 b,
                 b_to_a: c.transform,
-                weight: c.verification.wall_lift.clamp(0.01, 1.0),
+                weight: edge_weight(&c.verification),
             });
             edges.len() - 1
         });
