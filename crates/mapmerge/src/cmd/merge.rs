@@ -19,9 +19,9 @@ use super::{BareImageArgs, UsageError, load, refuse_overwriting, require_directo
 
 const AFTER: &str = "\
 How it works: every pair of maps is registered as `mapmerge estimate` does (n maps: n(n-1)/2
-pairs, in parallel). The accepted pairs form a graph; a spanning tree of the most confident
-answers places every map it reaches in the first map's frame, and the answers that close loops
-refine those poses by least squares (an answer that disagrees with the tree by more than 3
+pairs, in parallel). The accepted pairs form a graph; a spanning tree of the answers that
+rest on the most agreeing walls (large overlaps first) places every map it reaches in the
+first map's frame, and the answers that close loops refine those poses by least squares (an answer that disagrees with the tree by more than 3
 degrees or 8 px is dropped as wrong). The placed maps are then fused: where one map alone is
 known it keeps its cell; where several are, the cell takes their occupancy probabilities'
 mean weighted by --weights (the paper's alpha * M1 + beta * M2, alpha + beta = 1), or with
