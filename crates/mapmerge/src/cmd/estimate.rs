@@ -7,10 +7,12 @@ use std::process::ExitCode;
 use anyhow::Context;
 use clap::Args;
 use grid_core::{CellState, DVec2, OccupancyGrid, Rigid2};
-use mapmerge::{Method, RegisterConfig, Registration, register};
+use mapmerge::{Registration, register};
 use serde_json::json;
 
-use super::{BareImageArgs, UsageError, load, refuse_overwriting, require_directory};
+use super::{
+    BareImageArgs, RegistrationArgs, UsageError, load, refuse_overwriting, require_directory,
+};
 
 const AFTER: &str = "\
 Output (--json): one JSON object on stdout.
@@ -55,21 +57,12 @@ pub struct EstimateArgs {
     /// Print one JSON object instead of text
     #[arg(long)]
     pub json: bool,
-    /// Evidence used for correspondences: sift (intensity keypoints), blobs (obstacle
-    /// components) or hybrid (both)
-    #[arg(long, default_value = "hybrid", value_parser = parse_method)]
-    pub method: Method,
-    /// Seed of RANSAC; the same seed gives the same answer
-    #[arg(long, default_value_t = 0)]
-    pub seed: u64,
+    #[command(flatten)]
+    pub registration: RegistrationArgs,
     /// Write a picture of A, B with the matches (green: inliers, red: outliers) and B laid
     /// over A with the answer, both whole (A's walls blue, B's red, agreeing walls black)
     #[arg(long, value_name = "FILE")]
     pub debug_png: Option<PathBuf>,
-}
-
-fn parse_method(s: &str) -> Result<Method, String> {
-    s.parse()
 }
 
 /// Run `mapmerge estimate`.
@@ -97,11 +90,7 @@ pub fn run(args: &EstimateArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode
         ))
         .into());
     }
-    let mut config = RegisterConfig {
-        method: args.method,
-        ..RegisterConfig::default()
-    };
-    config.pair.ransac.seed = args.seed;
+    let config = args.registration.config();
     let result = register(&a.grid, &b.grid, &config).context("invalid registration settings")?;
     if let Some(png) = &args.debug_png {
         write_debug_png(
@@ -135,8 +124,8 @@ fn report(
     let common = json!({
         "a": args.a.display().to_string(),
         "b": args.b.display().to_string(),
-        "method": args.method,
-        "seed": args.seed,
+        "method": args.registration.method,
+        "seed": args.registration.seed,
         "correspondences": r.correspondences,
         "candidates": r.candidates.len(),
         "timings_ms": r.timings,

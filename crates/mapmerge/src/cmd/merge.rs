@@ -12,10 +12,11 @@ use fusion::{EdgeStatus, FusedMap, FusionConfig, FusionRule};
 use grid_core::io::{LoadedMap, image_path_for, save_map, write_atomic};
 use grid_core::{CellState, OccupancyGrid, Rigid2};
 use mapmerge::team::{TeamConfig, TeamPair, merge_team};
-use mapmerge::{Method, RegisterConfig};
 use serde_json::{Value, json};
 
-use super::{BareImageArgs, UsageError, load, refuse_overwriting, require_directory};
+use super::{
+    BareImageArgs, RegistrationArgs, UsageError, load, refuse_overwriting, require_directory,
+};
 
 const AFTER: &str = "\
 How it works: every pair of maps is registered as `mapmerge estimate` does (n maps: n(n-1)/2
@@ -76,21 +77,13 @@ pub struct MergeArgs {
     /// Print the report as one JSON object instead of text
     #[arg(long)]
     pub json: bool,
-    /// Evidence used for correspondences: sift, blobs or hybrid (as for estimate)
-    #[arg(long, default_value = "hybrid", value_parser = parse_method)]
-    pub method: Method,
-    /// Seed of RANSAC; the same seed gives the same merged map
-    #[arg(long, default_value_t = 0)]
-    pub seed: u64,
+    #[command(flatten)]
+    pub registration: RegistrationArgs,
     /// Write a picture of the merged map: free white, unknown grey, walls in the colour of the
     /// one map that saw them (the first blue, then red, green, orange, purple, ...), black where
     /// two maps or more saw them
     #[arg(long, value_name = "FILE")]
     pub debug_png: Option<PathBuf>,
-}
-
-fn parse_method(s: &str) -> Result<Method, String> {
-    s.parse()
 }
 
 fn parse_rule(s: &str) -> Result<FusionRule, String> {
@@ -174,18 +167,14 @@ pub fn run(args: &MergeArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode> {
         refuse_overwriting(out, flag, maps.iter().map(|m| &m.image_path))?;
     }
 
-    let mut team = TeamConfig {
-        register: RegisterConfig {
-            method: args.method,
-            ..RegisterConfig::default()
-        },
+    let team = TeamConfig {
+        register: args.registration.config(),
         fusion: FusionConfig {
             rule: args.rule,
             ..FusionConfig::default()
         },
         ..TeamConfig::default()
     };
-    team.register.pair.ransac.seed = args.seed;
     let grids: Vec<&OccupancyGrid> = maps.iter().map(|m| &m.grid).collect();
     let n_pairs = grids.len() * (grids.len() - 1) / 2;
     // Drawn on stderr, and only when it is a terminal: scripts and pipes see nothing.
@@ -217,8 +206,8 @@ pub fn run(args: &MergeArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode> {
             FusionRule::WeightedMean => "mean",
             FusionRule::OccupiedWins => "occupied-wins",
         },
-        "method": args.method,
-        "seed": args.seed,
+        "method": args.registration.method,
+        "seed": args.registration.seed,
         "pairs": merged.pairs.iter().map(|p| {
             pair_report(&args.maps, p, p.edge.map(|e| (solution.status[e], solution.residuals[e])))
         }).collect::<Vec<_>>(),

@@ -16,6 +16,7 @@ use anyhow::Context;
 use clap::Args;
 use grid_core::Pose2;
 use grid_core::io::{BareImageDefaults, LoadOptions, LoadedMap};
+use mapmerge::{Method, RegisterConfig};
 
 /// Exit code: success.
 pub const EXIT_OK: u8 = 0;
@@ -121,6 +122,34 @@ fn message(err: &anyhow::Error) -> String {
 /// Collapse a message to one line.
 fn one_line(s: &str) -> String {
     s.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+/// How each pair is registered: the flags `estimate` and `merge` share.
+#[derive(Debug, Clone, Args)]
+pub struct RegistrationArgs {
+    /// Evidence used for correspondences: sift (intensity keypoints), blobs (obstacle
+    /// components) or hybrid (both)
+    #[arg(long, default_value = "hybrid", value_parser = parse_method)]
+    pub method: Method,
+    /// Seed of RANSAC; the same seed gives the same answer
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+}
+
+impl RegistrationArgs {
+    /// The registration settings these flags ask for (the defaults otherwise).
+    pub fn config(&self) -> RegisterConfig {
+        let mut config = RegisterConfig {
+            method: self.method,
+            ..RegisterConfig::default()
+        };
+        config.pair.ransac.seed = self.seed;
+        config
+    }
+}
+
+fn parse_method(s: &str) -> Result<Method, String> {
+    s.parse()
 }
 
 /// How to read a map given as a bare image (no YAML). Ignored for YAML maps.
