@@ -314,6 +314,13 @@ fn bad_input_is_refused_with_exit_2_and_inputs_are_never_overwritten() {
         err.contains("--debug-png names one of the merged map's own files"),
         "{err}"
     );
+    // The same file by another name.
+    let pgm_too = format!("{}/./out.pgm", dir.path().display());
+    let err = fails(&[a_s, a_s, "-o", out_s, "--debug-png", &pgm_too]);
+    assert!(
+        err.contains("--debug-png names one of the merged map's own files"),
+        "{err}"
+    );
     let err = fails(&[a_s, s(&fixture("intel_lab")), "-o", out_s]);
     assert!(err.contains("resolution 0.1 m/cell differs"), "{err}");
     let missing = dir.path().join("nope.yaml");

@@ -22,11 +22,11 @@ const AFTER: &str = "\
 How it works: every pair of maps is registered as `mapmerge estimate` does (n maps: n(n-1)/2
 pairs, in parallel). The accepted pairs form a graph; a spanning tree of the answers that
 rest on the most agreeing walls (large overlaps first) places every map it reaches in the
-first map's frame, and the answers that close loops refine those poses by least squares (an answer that disagrees with the tree by more than 3
-degrees or 8 px is dropped as wrong). The placed maps are then fused: where one map alone is
-known it keeps its cell; where several are, the cell takes their occupancy probabilities'
-mean weighted by --weights (the paper's alpha * M1 + beta * M2, alpha + beta = 1), or with
---rule occupied-wins the wall any map saw.
+first map's frame, and the answers that close loops refine those poses by least squares (an
+answer that disagrees with the tree by more than 3 degrees or 8 px is dropped as wrong). The
+placed maps are then fused: where one map alone is known it keeps its cell; where several
+are, the cell takes their occupancy probabilities' mean weighted by --weights (the paper's
+alpha * M1 + beta * M2, alpha + beta = 1), or with --rule occupied-wins the wall any map saw.
 
 Output:
   OUT.yaml + OUT.pgm  the merged map, as map_saver writes it (0 occupied, 254 free, 205
@@ -141,7 +141,12 @@ pub fn run(args: &MergeArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode> {
         require_directory(out, flag)?;
     }
     if let Some(png) = &args.debug_png {
-        if written[..3].iter().any(|(out, _)| out == png) {
+        // Compared as absolute paths, so that `./out.pgm` is seen to be `out.pgm`.
+        let absolute = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
+        if written[..3]
+            .iter()
+            .any(|(out, _)| absolute(out) == absolute(png))
+        {
             return Err(UsageError(format!(
                 "{}: --debug-png names one of the merged map's own files; choose another",
                 png.display()
