@@ -40,6 +40,10 @@ pub struct Args {
     /// Use the spanning tree's poses only, without the least-squares refinement over loops
     #[arg(long)]
     pub no_refine: bool,
+    /// Use an accepted pair in the pose graph only at this wall lift or more [default: that
+    /// of `mapmerge merge`, `TeamConfig::min_edge_lift`, 0.75]
+    #[arg(long, value_parser = crate::eval::non_negative)]
+    pub min_edge_lift: Option<f64>,
     /// After the table, list every map not placed within 3 px, with each pair's outcome: its
     /// error against the truth and what the pose graph made of it
     #[arg(long)]
@@ -131,6 +135,9 @@ pub fn run(args: Args) -> Result<()> {
     );
     let mut config = TeamConfig::default();
     config.poses.refine = !args.no_refine;
+    if let Some(lift) = args.min_edge_lift {
+        config.min_edge_lift = lift;
+    }
     let mut out = String::new();
     let mut listing = String::new();
     out.push_str(

@@ -20,11 +20,11 @@ use super::{
 
 const AFTER: &str = "\
 How it works: every pair of maps is registered as `mapmerge estimate` does (n maps: n(n-1)/2
-pairs, in parallel). The accepted pairs form a graph; a spanning tree of the answers that
-rest on the most agreeing walls (large overlaps first) places every map it reaches in the
-first map's frame, and the answers that close loops refine those poses by least squares (an
-answer that disagrees with the tree by more than 3 degrees or 8 px is dropped as wrong). The
-placed maps are then fused: where one map alone is known it keeps its cell; where several
+pairs, in parallel). The pairs accepted at wall lift --min-lift or more form a graph; a
+spanning tree of the answers that rest on the most agreeing walls (large overlaps first)
+places every map it reaches in the first map's frame, and the answers that close loops
+refine those poses by least squares (an answer that disagrees with the tree by more than 3
+degrees or 8 px is dropped as wrong). The placed maps are then fused: where one map alone is known it keeps its cell; where several
 are, the cell takes their occupancy probabilities' mean weighted by --weights (the paper's
 alpha * M1 + beta * M2, alpha + beta = 1), or with --rule occupied-wins the wall any map saw.
 
@@ -38,12 +38,13 @@ Output:
                       world {x, y, yaw}: its map frame in the merged map's frame (metres, yaw
                       counter-clockwise), ready to publish as a TF; reason when not merged
     pairs             per pair a < b: accepted, transform (b's pixels onto a's), confidence,
-                      status (tree, loop, dropped, declined, unreached), residual of the
-                      final poses against the pair's answer (rotation_deg, translation_px)
+                      status (tree, loop, dropped, weak: accepted below --min-lift, declined,
+                      unreached), residual of the final poses against the pair's answer
+                      (rotation_deg, translation_px)
     acceptance_index  agree / (agree + disagree) over every two maps known at the same cell
     overlap_cells, output, timings_ms
 
-A map that no accepted pair links to the first map is left out (a warning on stderr says so)
+A map that no such pair links to the first map is left out (a warning on stderr says so)
 and the others are merged. When no map links to the first, nothing is written.
 
 Exit codes: 0 merged map written, 3 no map could be placed in the first map's frame (nothing
@@ -74,6 +75,10 @@ pub struct MergeArgs {
     /// any map saw stays)
     #[arg(long, default_value = "mean", value_parser = parse_rule)]
     pub rule: FusionRule,
+    /// A pair places maps only when accepted at this wall lift or more: a map placed wrong
+    /// spoils the merged map, one left out is reported; 0.65 uses every pair `estimate` accepts
+    #[arg(long, value_name = "LIFT", default_value_t = 0.75, value_parser = super::probability)]
+    pub min_lift: f64,
     /// Print the report as one JSON object instead of text
     #[arg(long)]
     pub json: bool,
@@ -178,6 +183,7 @@ pub fn run(args: &MergeArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode> {
             rule: args.rule,
             ..FusionConfig::default()
         },
+        min_edge_lift: args.min_lift,
         ..TeamConfig::default()
     };
     let grids: Vec<&OccupancyGrid> = maps.iter().map(|m| &m.grid).collect();
@@ -214,7 +220,7 @@ pub fn run(args: &MergeArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode> {
         "method": args.registration.method,
         "seed": args.registration.seed,
         "pairs": merged.pairs.iter().map(|p| {
-            pair_report(&args.maps, p, p.edge.map(|e| (solution.status[e], solution.residuals[e])))
+            pair_report(&args.maps, p, p.edge.map(|e| (solution.status[e], solution.residuals[e])), args.min_lift)
         }).collect::<Vec<_>>(),
     });
     let mut map_reports: Vec<Value> = args
@@ -228,7 +234,11 @@ pub fn run(args: &MergeArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode> {
                 "weight": w,
                 "transform": null,
                 "world": null,
-                "reason": format!("no accepted pair links it to {}", args.maps[0].display()),
+                "reason": format!(
+                    "no pair accepted at wall lift {} or more links it to {}",
+                    args.min_lift,
+                    args.maps[0].display()
+                ),
             })
         })
         .collect();
@@ -327,6 +337,7 @@ fn pair_report(
     paths: &[PathBuf],
     p: &TeamPair,
     edge: Option<(EdgeStatus, fusion::EdgeResidual)>,
+    min_lift: f64,
 ) -> Value {
     let r = &p.registration;
     let mut v = json!({
@@ -335,6 +346,15 @@ fn pair_report(
         "accepted": r.accepted.is_some(),
     });
     match (&r.accepted, edge) {
+        (Some(c), None) => {
+            v["transform"] = transform_json(&c.transform);
+            v["confidence"] = json!(c.verification.wall_lift.clamp(0.0, 1.0));
+            v["status"] = json!("weak");
+            v["reason"] = json!(format!(
+                "accepted at wall lift {:.2}, below --min-lift {min_lift}: not used to place maps",
+                c.verification.wall_lift
+            ));
+        }
         (Some(c), Some((status, residual))) => {
             v["transform"] = transform_json(&c.transform);
             v["confidence"] = json!(c.verification.wall_lift.clamp(0.0, 1.0));
@@ -434,7 +454,13 @@ fn human(w: &mut impl Write, r: &Value) -> std::io::Result<()> {
             p["a"].as_str().unwrap_or("?"),
             p["b"].as_str().unwrap_or("?"),
         );
-        if p["accepted"] == true {
+        if p["status"] == "weak" {
+            writeln!(
+                w,
+                "  pair {a} + {b}: {}",
+                p["reason"].as_str().unwrap_or("?")
+            )?;
+        } else if p["accepted"] == true {
             writeln!(
                 w,
                 "  pair {a} + {b}: accepted, confidence {:.2}, {} (residual {:.2} deg, {:.2} px)",
