@@ -24,9 +24,10 @@ pairs, in parallel). The pairs accepted at wall lift --min-lift or more form a g
 spanning tree of the answers that rest on the most agreeing walls (large overlaps first)
 places every map it reaches in the first map's frame, and the answers that close loops
 refine those poses by least squares (an answer that disagrees with the tree by more than 3
-degrees or 8 px is dropped as wrong). The placed maps are then fused: where one map alone is known it keeps its cell; where several
-are, the cell takes their occupancy probabilities' mean weighted by --weights (the paper's
-alpha * M1 + beta * M2, alpha + beta = 1), or with --rule occupied-wins the wall any map saw.
+degrees or 8 px is dropped as wrong). The placed maps are then fused: where one map alone
+is known it keeps its cell; where several are, the cell takes their occupancy probabilities'
+mean weighted by --weights (the paper's alpha * M1 + beta * M2, alpha + beta = 1), or with
+--rule occupied-wins the wall any map saw.
 
 Output:
   OUT.yaml + OUT.pgm  the merged map, as map_saver writes it (0 occupied, 254 free, 205
