@@ -40,7 +40,7 @@ pub struct TeamConfig {
     /// The map whose frame the result is in; default 0, the first.
     pub reference: usize,
     /// An accepted pair becomes an edge of the pose graph only with a wall lift of at least
-    /// this; default 0.75, above the 0.65 a pair is accepted from. A map placed wrong spoils
+    /// this; default 0.75 (a pair is accepted from 0.65, or lower when it stands out). A map placed wrong spoils
     /// the merged map, while one left out is only missing (and reported), and in a team a map
     /// often has another way in: of the 400 maps of `cargo xtask team --seed 7` at 50 and 30 %
     /// overlap the bar cut those placed more than 3 px off from 48 to 18, and those placed

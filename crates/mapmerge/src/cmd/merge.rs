@@ -77,7 +77,7 @@ pub struct MergeArgs {
     #[arg(long, default_value = "mean", value_parser = parse_rule)]
     pub rule: FusionRule,
     /// A pair places maps only when accepted at this wall lift or more: a map placed wrong
-    /// spoils the merged map, one left out is reported; 0.65 uses every pair `estimate` accepts
+    /// spoils the merged map, one left out is reported; 0 uses every pair `estimate` accepts
     #[arg(long, value_name = "LIFT", default_value_t = 0.75, value_parser = super::probability)]
     pub min_lift: f64,
     /// Print the report as one JSON object instead of text
