@@ -28,7 +28,8 @@ use crate::picture;
 pub struct EvalArgs {
     /// Suites to run (comma separated): overlap, zero, noise, mismatch, paper, real, large (the
     /// nav2 warehouse, maps about 1800 x 900 cells; slow to simulate), floors (five real
-    /// building floors at 30 % overlap and equal noise, one never tuned on), or `all`.
+    /// building floors at 30 % overlap and equal noise, one never tuned on), floorzero (the
+    /// same floors at zero overlap: must decline), or `all`.
     #[arg(long, value_delimiter = ',', default_value = "overlap,zero")]
     suites: Vec<String>,
     /// Cases per suite row.
@@ -470,6 +471,15 @@ fn fixture_floor(name: &str) -> Result<OccupancyGrid> {
 
 /// A row of `suite`: two lidar robots with 10 % range noise exploring the floor
 /// `fixtures/maps/NAME` at the smallest overlap, 30 %.
+/// The real floors of the `floors` and `floorzero` suites.
+const FLOORS: [&str; 5] = [
+    "wpi_ilab",
+    "aws_small_house",
+    "uos_cic",
+    "intel_lab",
+    "uos_avz",
+];
+
 fn floor_at_30(suite: &'static str, name: &str) -> Result<Row> {
     Ok(Row {
         suite,
@@ -634,14 +644,27 @@ fn rows(suites: &[String], size: usize, mapper: Mapper) -> Result<Vec<Row>> {
         // too small to split (its pairs overlap 78-94 %) and alike under turns of a sixth, so
         // its pairs are rightly declined as ambiguous. Listed last, so that every other row
         // keeps its cases.
-        for name in [
-            "wpi_ilab",
-            "aws_small_house",
-            "uos_cic",
-            "intel_lab",
-            "uos_avz",
-        ] {
+        for name in FLOORS {
             rows.push(floor_at_30("floors", name)?);
+        }
+    }
+    if want("floorzero") {
+        // The same five real floors explored by two robots whose areas do not overlap: the
+        // pairs must be declined. Real buildings repeat rooms and walls more than the simulated
+        // worlds do. Listed last, so that every other row keeps its cases.
+        for name in FLOORS {
+            let mut config = case(
+                world(WorldKind::Grid(fixture_floor(name)?), 0),
+                vec![lidar(0.10), lidar(0.10)],
+                0.0,
+            );
+            config.overlap_tolerance = 0.02;
+            rows.push(Row {
+                suite: "floorzero",
+                label: format!("{name} world, overlap 0 (must decline), noise 10%/10%"),
+                config,
+                expect_decline: true,
+            });
         }
     }
     anyhow::ensure!(!rows.is_empty(), "no known suite in {suites:?}");

@@ -20,9 +20,10 @@ Sets (20 cases per row, as in docs/EVALUATION.md):
   ovl     every overlap row, seed 7                       ovlh    hector's, seed 7
   large   the nav2 warehouse, seeds 7, 8                  largeh  hector's, seed 8
   floors  five real floors at 30 % overlap, seeds 7, 8
+  floorzero  the same floors at zero overlap (must decline), seed 7
 All of them but floors took 19 minutes on a 2-core Intel Xeon VM (2026-12-05); floors
 took 4 minutes a seed there. In a faster hour of that VM the whole batch, floors included,
-took 20 minutes (2026-12-05, 18:42-19:02 UTC).
+took 20 minutes (2026-12-05, 18:42-19:02 UTC); floorzero took 1 minute (22:14 UTC).
 
 Examples:
   cargo xtask regress --out /tmp/before
@@ -127,6 +128,13 @@ const SETS: &[Set] = &[
         hector: false,
         seeds: &[7, 8],
     },
+    Set {
+        name: "floorzero",
+        suites: "floorzero",
+        only: None,
+        hector: false,
+        seeds: &[7],
+    },
 ];
 
 /// `eval`'s arguments as one wraps them to parse them alone.
@@ -229,10 +237,33 @@ mod tests {
         assert_eq!(
             names,
             [
-                "o30_7", "o30_8", "o30_9", "o30h_7", "o30h_8", "o30h_9", "real_7", "real_8",
-                "real_9", "realh_8", "realh_9", "zero_1", "zero_2", "zero_3", "zero_7", "zeroh_1",
-                "zeroh_2", "zeroh_3", "zeroh_7", "ovl_7", "ovlh_7", "large_7", "large_8",
-                "largeh_8", "floors_7", "floors_8"
+                "o30_7",
+                "o30_8",
+                "o30_9",
+                "o30h_7",
+                "o30h_8",
+                "o30h_9",
+                "real_7",
+                "real_8",
+                "real_9",
+                "realh_8",
+                "realh_9",
+                "zero_1",
+                "zero_2",
+                "zero_3",
+                "zero_7",
+                "zeroh_1",
+                "zeroh_2",
+                "zeroh_3",
+                "zeroh_7",
+                "ovl_7",
+                "ovlh_7",
+                "large_7",
+                "large_8",
+                "largeh_8",
+                "floors_7",
+                "floors_8",
+                "floorzero_7"
             ]
         );
         for (_, argv) in &runs {
