@@ -471,6 +471,20 @@ fn fixture_floor(name: &str) -> Result<OccupancyGrid> {
 
 /// A row of `suite`: two lidar robots with 10 % range noise exploring the floor
 /// `fixtures/maps/NAME` at the smallest overlap, 30 %.
+/// A row of pairs that must be declined: two robots with range noise `noise` whose explored
+/// areas do not overlap (within 0.02; a case that cannot be split so fails to generate instead
+/// of posing as a zero-overlap pair).
+fn must_decline(suite: &'static str, label: String, world: WorldConfig, noise: f64) -> Row {
+    let mut config = case(world, vec![lidar(noise), lidar(noise)], 0.0);
+    config.overlap_tolerance = 0.02;
+    Row {
+        suite,
+        label,
+        config,
+        expect_decline: true,
+    }
+}
+
 /// The real floors of the `floors` and `floorzero` suites.
 const FLOORS: [&str; 5] = [
     "wpi_ilab",
@@ -521,18 +535,12 @@ fn rows(suites: &[String], size: usize, mapper: Mapper) -> Result<Vec<Row>> {
         for (wname, kind) in &kinds {
             // A tour may cross itself (indoor corridors), so a disjoint split does not always
             // exist: such a case fails to generate instead of posing as a zero-overlap pair.
-            let mut config = case(
+            rows.push(must_decline(
+                "zero",
+                format!("{wname}, overlap 0 (must decline)"),
                 world(kind.clone(), size),
-                vec![lidar(0.10), lidar(0.10)],
-                0.0,
-            );
-            config.overlap_tolerance = 0.02;
-            rows.push(Row {
-                suite: "zero",
-                label: format!("{wname}, overlap 0 (must decline)"),
-                config,
-                expect_decline: true,
-            });
+                0.10,
+            ));
         }
     }
     if want("noise") {
@@ -596,21 +604,15 @@ fn rows(suites: &[String], size: usize, mapper: Mapper) -> Result<Vec<Row>> {
         // (the noise suite's 30 % and 50 % rows). Listed last, so that adding these rows left
         // every other row's cases as they were: a row's cases are drawn from its index.
         for noise in [0.3, 0.5] {
-            let mut config = case(
-                world(WorldKind::Disaster, size),
-                vec![lidar(noise), lidar(noise)],
-                0.0,
-            );
-            config.overlap_tolerance = 0.02;
-            rows.push(Row {
-                suite: "zero",
-                label: format!(
+            rows.push(must_decline(
+                "zero",
+                format!(
                     "disaster, overlap 0 (must decline), noise {0:.0}%/{0:.0}%",
                     noise * 100.0
                 ),
-                config,
-                expect_decline: true,
-            });
+                world(WorldKind::Disaster, size),
+                noise,
+            ));
         }
     }
     if want("paper") {
@@ -653,18 +655,12 @@ fn rows(suites: &[String], size: usize, mapper: Mapper) -> Result<Vec<Row>> {
         // pairs must be declined. Real buildings repeat rooms and walls more than the simulated
         // worlds do. Listed last, so that every other row keeps its cases.
         for name in FLOORS {
-            let mut config = case(
+            rows.push(must_decline(
+                "floorzero",
+                format!("{name} world, overlap 0 (must decline), noise 10%/10%"),
                 world(WorldKind::Grid(fixture_floor(name)?), 0),
-                vec![lidar(0.10), lidar(0.10)],
-                0.0,
-            );
-            config.overlap_tolerance = 0.02;
-            rows.push(Row {
-                suite: "floorzero",
-                label: format!("{name} world, overlap 0 (must decline), noise 10%/10%"),
-                config,
-                expect_decline: true,
-            });
+                0.10,
+            ));
         }
     }
     anyhow::ensure!(!rows.is_empty(), "no known suite in {suites:?}");
