@@ -1088,20 +1088,6 @@ fn run_case(
         .collect()
 }
 
-/// The centroid of a grid's known cells, if it has any.
-fn known_centroid(grid: &grid_core::OccupancyGrid) -> Option<DVec2> {
-    let (mut sum, mut n) = (DVec2::ZERO, 0.0);
-    for y in 0..grid.height() {
-        for x in 0..grid.width() {
-            if grid.state(x, y) != grid_core::CellState::Unknown {
-                sum += DVec2::new(x as f64, y as f64);
-                n += 1.0;
-            }
-        }
-    }
-    (n > 0.0).then(|| sum / n)
-}
-
 /// See [`Outcome::separation_error_px`]: `[along, across]`, or `None` when a map has no known
 /// cell or the two centroids coincide.
 fn separation_error(
@@ -1110,7 +1096,7 @@ fn separation_error(
     answer: &Rigid2,
     truth: &Rigid2,
 ) -> Option<[f64; 2]> {
-    let (ca, cb) = (known_centroid(a)?, known_centroid(b)?);
+    let (ca, cb) = (a.known_centroid()?, b.known_centroid()?);
     let towards_b = (truth.apply(cb) - ca).try_normalize()?;
     let e = answer.apply(cb) - truth.apply(cb);
     Some([e.dot(towards_b), towards_b.perp_dot(e)])

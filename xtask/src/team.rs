@@ -140,6 +140,7 @@ pub fn run(args: Args) -> Result<()> {
     }
     let mut out = String::new();
     let mut listing = String::new();
+    let mut totals = Tally::default();
     out.push_str(
         "| team | cases | maps linked to the first in the truth | maps placed | within 3 px | placed > 3 px off | teams all within 3 px | star: within 3 px | star: placed > 3 px off | star: teams all within 3 px | median error (px) | mean time (ms) |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
@@ -232,7 +233,13 @@ pub fn run(args: Args) -> Result<()> {
                             displacement_error(grids[p.b], &c.transform, &case.truth(p.a, p.b))
                                 .unwrap_or(f64::INFINITY)
                         ),
-                        _ => "declined".into(),
+                        (Some(c), None) => format!(
+                            "weak (lift {:.2}, below the bar), {:.2} px off",
+                            c.verification.wall_lift,
+                            displacement_error(grids[p.b], &c.transform, &case.truth(p.a, p.b))
+                                .unwrap_or(f64::INFINITY)
+                        ),
+                        (None, _) => "declined".into(),
                     };
                     listing.push_str(&format!(
                         "    pair ({}, {}), overlap {:.2}: {what}\n",
@@ -243,6 +250,11 @@ pub fn run(args: Args) -> Result<()> {
             t.all_right += usize::from(all);
             t.star_all_right += usize::from(star_all);
         }
+        totals.maps += t.maps;
+        totals.right += t.right;
+        totals.wrong += t.wrong;
+        totals.star_right += t.star_right;
+        totals.star_placed += t.star_placed;
         t.errors.sort_by(f64::total_cmp);
         let median = t
             .errors
@@ -268,6 +280,14 @@ pub fn run(args: Args) -> Result<()> {
         ));
     }
     bar.finish_and_clear();
+    out.push_str(&format!(
+        "\nAll rows: {} maps besides the first ones; {} placed within 3 px, {} placed more than 3 px off (the star: {} and {}).\n",
+        totals.maps,
+        totals.right,
+        totals.wrong,
+        totals.star_right,
+        totals.star_placed - totals.star_right
+    ));
     print!("{out}{listing}");
     Ok(())
 }

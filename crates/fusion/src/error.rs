@@ -28,6 +28,22 @@ pub enum FusionError {
         /// The weight given.
         weight: f64,
     },
+    /// A pair edge's weight (confidence) that is not a finite positive number.
+    #[error("pair edge {index}'s weight {weight} is not a finite number greater than 0")]
+    EdgeWeight {
+        /// Index of the edge.
+        index: usize,
+        /// The weight given.
+        weight: f64,
+    },
+    /// The reference map of the pose graph is not one of its maps.
+    #[error("the reference map {reference} is not one of the {nodes} maps")]
+    Reference {
+        /// The reference given.
+        reference: usize,
+        /// Number of maps.
+        nodes: usize,
+    },
     /// A pose or pairwise transform with a NaN or infinite component.
     #[error("{what} is not finite")]
     NotFinite {

@@ -102,7 +102,10 @@ pub fn solve_poses(
 ) -> Result<PoseGraphSolution> {
     let n = centres.len();
     if reference >= n {
-        return Err(FusionError::NoMaps);
+        return Err(FusionError::Reference {
+            reference,
+            nodes: n,
+        });
     }
     for (index, e) in edges.iter().enumerate() {
         if e.a >= n || e.b >= n || e.a == e.b {
@@ -120,8 +123,9 @@ pub fn solve_poses(
             });
         }
         if !(e.weight.is_finite() && e.weight > 0.0) {
-            return Err(FusionError::NotFinite {
-                what: format!("pair edge {index}'s weight (it must be greater than 0)"),
+            return Err(FusionError::EdgeWeight {
+                index,
+                weight: e.weight,
             });
         }
     }
@@ -455,7 +459,14 @@ mod tests {
         let e = edge(&t, 0, 1, 0.0);
         assert!(matches!(
             solve_poses(&c, 0, &[e], &config),
-            Err(FusionError::NotFinite { .. })
+            Err(FusionError::EdgeWeight { index: 0, .. })
+        ));
+        assert!(matches!(
+            solve_poses(&c, 2, &[], &config),
+            Err(FusionError::Reference {
+                reference: 2,
+                nodes: 2
+            })
         ));
     }
 

@@ -332,6 +332,20 @@ impl OccupancyGrid {
         self.get(x, y).map_or(CellState::Unknown, Self::classify)
     }
 
+    /// The mean pixel of the known (free or occupied) cells, `None` when no cell is known.
+    pub fn known_centroid(&self) -> Option<DVec2> {
+        let (mut sum, mut n) = (DVec2::ZERO, 0usize);
+        for y in 0..self.height() {
+            for x in 0..self.width() {
+                if self.state(x, y) != CellState::Unknown {
+                    sum += DVec2::new(x as f64, y as f64);
+                    n += 1;
+                }
+            }
+        }
+        (n > 0).then(|| sum / n as f64)
+    }
+
     /// Number of free, occupied and unknown cells.
     pub fn counts(&self) -> CellCounts {
         let mut counts = CellCounts::default();
@@ -449,6 +463,16 @@ fn last_known(row: &[u8]) -> Option<usize> {
 mod tests {
     use super::*;
     use proptest::prelude::*;
+
+    #[test]
+    fn the_known_centroid_is_the_mean_of_the_known_cells() {
+        // Known cells at (0, 0), (2, 0) and (2, 2); (1, 1) holds 50 %, which reads as unknown.
+        let cells = vec![0, UNKNOWN, 100, UNKNOWN, 50, UNKNOWN, UNKNOWN, UNKNOWN, 0];
+        let g = OccupancyGrid::from_cells(3, 3, 0.05, Pose2::default(), cells).unwrap();
+        assert_eq!(g.known_centroid(), Some(DVec2::new(4.0 / 3.0, 2.0 / 3.0)));
+        let blank = OccupancyGrid::new(2, 2, 0.05, Pose2::default()).unwrap();
+        assert_eq!(blank.known_centroid(), None);
+    }
 
     #[test]
     fn a_region_copies_the_cells_it_covers_and_is_unknown_past_the_grid() {

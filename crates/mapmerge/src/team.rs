@@ -5,7 +5,7 @@
 use fusion::{
     FusedMap, FusionConfig, FusionError, MapPlacement, PairEdge, PoseGraphConfig, PoseGraphSolution,
 };
-use grid_core::{CellState, DVec2, OccupancyGrid};
+use grid_core::{DVec2, OccupancyGrid};
 use rayon::prelude::*;
 
 use crate::{RegisterConfig, Registration, register};
@@ -92,23 +92,11 @@ pub struct TeamMerge {
     pub fused: Option<FusedMap>,
 }
 
-/// The mean pixel of a map's known cells (the middle of the grid when none is known): where
-/// the pose graph measures how far apart two answers put the map.
+/// Where the pose graph measures how far apart two answers put a map: the mean pixel of its
+/// known cells ([`OccupancyGrid::known_centroid`]), the middle of the grid when none is known.
 pub fn known_centre(g: &OccupancyGrid) -> DVec2 {
-    let (mut sum, mut n) = (DVec2::ZERO, 0usize);
-    for y in 0..g.height() {
-        for x in 0..g.width() {
-            if g.state(x, y) != CellState::Unknown {
-                sum += DVec2::new(x as f64, y as f64);
-                n += 1;
-            }
-        }
-    }
-    if n == 0 {
-        DVec2::new(g.width() as f64, g.height() as f64) * 0.5
-    } else {
-        sum / n as f64
-    }
+    g.known_centroid()
+        .unwrap_or_else(|| DVec2::new(g.width() as f64, g.height() as f64) * 0.5)
 }
 
 /// How much the pose graph trusts an accepted answer: the wall cells that agree (compared

@@ -38,20 +38,6 @@ fn transform(v: &serde_json::Value) -> Rigid2 {
     )
 }
 
-/// Centre of the known cells of `g`.
-fn known_centre(g: &OccupancyGrid) -> DVec2 {
-    let (mut s, mut n) = (DVec2::ZERO, 0.0);
-    for y in 0..g.height() {
-        for x in 0..g.width() {
-            if g.state(x, y) != CellState::Unknown {
-                s += DVec2::new(x as f64, y as f64);
-                n += 1.0;
-            }
-        }
-    }
-    s / n
-}
-
 /// Write B = a rotated, shifted crop of `a` (B's centre lands on A's known centre plus `shift`)
 /// and return its path and the true B→A transform.
 fn rotated_crop(
@@ -63,7 +49,7 @@ fn rotated_crop(
 ) -> (PathBuf, Rigid2) {
     let half = DVec2::splat(size as f64 / 2.0);
     let rot = DVec2::from_angle(theta_deg.to_radians());
-    let t = known_centre(a) + shift - rot.rotate(half);
+    let t = a.known_centroid().unwrap() + shift - rot.rotate(half);
     let truth = Rigid2::new(theta_deg.to_radians(), t.x, t.y);
     let b = a.warp(&truth.inverse(), size, size).unwrap();
     let path = dir.path().join("b.yaml");
