@@ -52,6 +52,19 @@ pub enum Error {
         /// What is wrong, in words a user can act on.
         reason: String,
     },
+    /// [`crate::OccupancyGrid::resample`] would make a grid of more than 2^28 cells.
+    #[error(
+        "the map would be {width} x {height} cells at {resolution} m/cell, more than 2^28 \
+         (268435456)"
+    )]
+    ResampleTooLarge {
+        /// Width in cells it would have.
+        width: f64,
+        /// Height in cells it would have.
+        height: f64,
+        /// The resolution asked for.
+        resolution: f64,
+    },
     /// A map was read fine but holds no free or occupied cell, so there is nothing to register
     /// or merge. The loader never returns it (an all-unknown map is a valid file); callers that
     /// need known cells use [`crate::io::require_known_cells`].

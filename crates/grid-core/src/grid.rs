@@ -410,6 +410,75 @@ impl OccupancyGrid {
         Self::from_cells(width, height, g.resolution, g.origin, cells)
     }
 
+    /// This map at another `resolution` (metres per cell), covering the same ground: the
+    /// origin (the lower-left corner of the lower-left cell, and the yaw) is kept, and the
+    /// grid is as many cells wide and high as it takes to cover the old extent (rounded up,
+    /// the extra cells unknown, at the right and the top).
+    ///
+    /// A new cell takes the highest occupancy among the old cells whose centres lie in it,
+    /// unknown when all of those are (coarser: a wall any old cell held stays a wall, and a
+    /// cell partly seen is known); when no old centre lies in it (finer), the old cell under
+    /// its centre. So halving and doubling the resolution round-trips exactly, and at the
+    /// same resolution the map is unchanged.
+    ///
+    /// `resolution` must be finite and positive ([`Error::Resolution`]), and the result at
+    /// most 2^28 cells ([`Error::ResampleTooLarge`]).
+    pub fn resample(&self, resolution: f64) -> Result<Self> {
+        if !(resolution.is_finite() && resolution > 0.0) {
+            return Err(Error::Resolution(resolution));
+        }
+        let ratio = resolution / self.resolution();
+        // Rounding up, but a size that is whole up to rounding error stays whole.
+        let cells_for = |n: usize| ((n as f64 / ratio) - 1e-9).ceil().max(1.0);
+        let (wf, hf) = (cells_for(self.width()), cells_for(self.height()));
+        if wf * hf > (1u64 << 28) as f64 {
+            return Err(Error::ResampleTooLarge {
+                width: wf,
+                height: hf,
+                resolution,
+            });
+        }
+        let (w, h) = (wf as usize, hf as usize);
+        // The old cells (counted from the lower-left, along one axis) whose centres lie in new
+        // cell `k`: centres `(i + 0.5) r_old` in `[k r_new, (k + 1) r_new)`; else the old cell
+        // under the new cell's centre. Clamped to the `n` old cells.
+        let span = |k: usize, n: usize| {
+            let lo = ((k as f64 * ratio - 0.5 - 1e-9).ceil().max(0.0) as usize).min(n);
+            let hi = (((k + 1) as f64 * ratio - 0.5 - 1e-9).ceil().max(0.0) as usize).min(n);
+            if lo < hi {
+                lo..hi
+            } else {
+                let c = (((k as f64 + 0.5) * ratio) as usize).min(n.saturating_sub(1));
+                // Past the old grid (the rounded-up margin): nothing.
+                if ((k as f64 + 0.5) * ratio) < n as f64 {
+                    c..c + 1
+                } else {
+                    0..0
+                }
+            }
+        };
+        let columns: Vec<_> = (0..w).map(|x| span(x, self.width())).collect();
+        let mut cells = vec![UNKNOWN; w * h];
+        for (y, row) in cells.chunks_exact_mut(w).enumerate() {
+            // Rows are counted from the top in the grid, from the bottom here.
+            let rows = span(h - 1 - y, self.height());
+            for (cell, cols) in row.iter_mut().zip(&columns) {
+                let mut best = UNKNOWN;
+                for from_bottom in rows.clone() {
+                    let old = &self.cells[(self.height() - 1 - from_bottom) * self.width()..];
+                    for &v in &old[cols.clone()] {
+                        // Known values are 0..=100, UNKNOWN is 255: the highest known one.
+                        if v <= 100 && (best == UNKNOWN || v > best) {
+                            best = v;
+                        }
+                    }
+                }
+                *cell = best;
+            }
+        }
+        Self::from_cells(w, h, resolution, self.origin(), cells)
+    }
+
     /// World coordinates of pixel coordinates `p`; see [`GridGeometry::pixel_to_world`].
     pub fn pixel_to_world(&self, p: DVec2) -> DVec2 {
         self.geometry.pixel_to_world(p)
@@ -472,6 +541,68 @@ mod tests {
         assert_eq!(g.known_centroid(), Some(DVec2::new(4.0 / 3.0, 2.0 / 3.0)));
         let blank = OccupancyGrid::new(2, 2, 0.05, Pose2::default()).unwrap();
         assert_eq!(blank.known_centroid(), None);
+    }
+
+    #[test]
+    fn a_coarser_map_takes_the_highest_occupancy_of_each_block_and_keeps_its_origin() {
+        // 5 x 3 cells at 0.05 m; at 0.1 m: 3 x 2 cells (rounded up), the blocks counted from
+        // the lower-left corner, so the top row and the right column are half blocks.
+        #[rustfmt::skip]
+        let cells = vec![
+            0,       UNKNOWN, 100,     UNKNOWN, 10,
+            UNKNOWN, UNKNOWN, 0,       40,      UNKNOWN,
+            UNKNOWN, 20,      70,      0,       UNKNOWN,
+        ];
+        let origin = Pose2::new(1.5, -2.0, 0.3);
+        let g = OccupancyGrid::from_cells(5, 3, 0.05, origin, cells).unwrap();
+        let c = g.resample(0.1).unwrap();
+        assert_eq!((c.width(), c.height(), c.resolution()), (3, 2, 0.1));
+        assert_eq!(c.origin(), origin);
+        #[rustfmt::skip]
+        let expected = vec![
+            0,  100, 10,      // the top old row alone
+            20, 70,  UNKNOWN, // old rows 1 and 2, two columns a cell; column 4 all unknown
+        ];
+        assert_eq!(c.cells(), expected.as_slice());
+        // The lower-left corner of the grid is the same place in the world.
+        let corner =
+            |m: &OccupancyGrid| m.pixel_to_world(DVec2::new(-0.5, m.height() as f64 - 0.5));
+        assert!((corner(&c) - corner(&g)).length() < 1e-12);
+    }
+
+    #[test]
+    fn a_finer_map_repeats_each_cell_and_halving_it_again_gives_the_map_back() {
+        let cells: Vec<u8> = vec![0, 100, UNKNOWN, 50, 25, 65];
+        let g = OccupancyGrid::from_cells(3, 2, 0.1, Pose2::new(-4.0, 2.5, -1.0), cells).unwrap();
+        let f = g.resample(0.05).unwrap();
+        assert_eq!((f.width(), f.height()), (6, 4));
+        for y in 0..4 {
+            for x in 0..6 {
+                assert_eq!(f.get(x, y), g.get(x / 2, y / 2), "cell ({x}, {y})");
+            }
+        }
+        assert_eq!(f.resample(0.1).unwrap(), g);
+        assert_eq!(g.resample(0.1).unwrap(), g);
+        // A cell's centre keeps its world coordinates within half a new cell.
+        let p = g.pixel_to_world(DVec2::new(2.0, 1.0));
+        let q = f.world_to_pixel(p);
+        assert!((q - DVec2::new(4.5, 2.5)).length() < 1e-9, "{q}");
+    }
+
+    #[test]
+    fn resampling_refuses_a_resolution_that_is_not_positive_or_a_grid_too_large() {
+        let g = OccupancyGrid::new(4, 4, 0.05, Pose2::default()).unwrap();
+        for bad in [0.0, -0.1, f64::NAN, f64::INFINITY] {
+            assert!(
+                matches!(g.resample(bad), Err(Error::Resolution(_))),
+                "{bad}"
+            );
+        }
+        let big = OccupancyGrid::new(1000, 1000, 0.05, Pose2::default()).unwrap();
+        assert!(matches!(
+            big.resample(0.0001),
+            Err(Error::ResampleTooLarge { .. })
+        ));
     }
 
     #[test]

@@ -150,6 +150,100 @@ fn three_turned_crops_of_a_real_floor_merge_back_into_the_floor() {
     );
 }
 
+/// Map pixel `p` of a map of `height` rows at `own` m/cell to its pixel once resampled to
+/// `to` m/cell with `resampled_height` rows (the lower-left corner kept).
+fn resampled_pixel(p: DVec2, own: f64, height: usize, to: f64, resampled_height: usize) -> DVec2 {
+    let s = own / to;
+    DVec2::new(
+        (p.x + 0.5) * s - 0.5,
+        resampled_height as f64 - 0.5 - (height as f64 - 0.5 - p.y) * s,
+    )
+}
+
+#[test]
+fn maps_of_other_resolutions_are_resampled_to_the_first_ones() {
+    let dir = TempDir::new().unwrap();
+    let floor = load_map(fixture("intel_lab"), &LoadOptions::default()).unwrap();
+    let w = floor.width();
+    let to = [turned(&floor, 0.0), turned(&floor, 30.0)];
+    let (a, _) = crop(&dir, "west", &floor, |x, _| x < w * 6 / 10, to[0]);
+    let (_, gb) = crop(&dir, "east", &floor, |x, _| x >= w * 4 / 10, to[1]);
+    // The east crop as a finer robot would map it (0.05 m/cell, each cell four), and as a
+    // coarser one would (0.2 m/cell, the highest occupancy of each four cells). Measured:
+    // 0.12 and 0.31 px off (in the merged map's cells), the frame 0.011 and 0.051 m.
+    let r = floor.resolution();
+    for (name, res, bound_px) in [("east_fine", r / 2.0, 0.5), ("east_coarse", r * 2.0, 1.5)] {
+        let gk = gb.resample(res).unwrap();
+        let path = dir.path().join(format!("{name}.yaml"));
+        save_map(&gk, &path).unwrap();
+        let out = dir.path().join(format!("{name}_team.yaml"));
+        let o = merge(&[s(&a), s(&path), "-o", s(&out), "--json"]);
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(0), "{stderr}");
+        assert_eq!(
+            stderr.trim_end(),
+            format!(
+                "mapmerge: note: {}: resampled from {res} to {r} m/cell, the resolution of {}",
+                path.display(),
+                a.display()
+            )
+        );
+        let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        let merged = load_map(&out, &LoadOptions::default()).unwrap();
+        assert_eq!(merged.resolution(), r);
+        let maps = report["maps"].as_array().unwrap();
+        assert_eq!(maps[1]["resolution"], res);
+        let t = &maps[1]["transform"];
+        let scale = t["scale"].as_f64().unwrap();
+        assert_eq!(
+            (maps[0]["transform"]["scale"].as_f64(), scale),
+            (Some(1.0), res / r)
+        );
+        // The report's transform takes the map's own pixels to the merged map's:
+        // `scale R x + t`. Against the truth, at the map's known cells: own pixel -> the crop
+        // at 0.1 m/cell -> floor -> west crop -> merged map.
+        let pose = transform(t);
+        let reference = transform(&maps[0]["transform"]);
+        let truth = reference.compose(&to[0]).compose(&to[1].inverse());
+        let (mut sum, mut n) = (0.0, 0usize);
+        for y in (0..gk.height()).step_by(3) {
+            for x in (0..gk.width()).step_by(3) {
+                if gk.state(x, y) == CellState::Unknown {
+                    continue;
+                }
+                let p = DVec2::new(x as f64, y as f64);
+                let got =
+                    DVec2::new(pose.tx, pose.ty) + scale * DVec2::from_angle(pose.theta).rotate(p);
+                let in_crop = resampled_pixel(p, res, gk.height(), r, gb.height());
+                sum += (got - truth.apply(in_crop)).length();
+                n += 1;
+            }
+        }
+        let disp = sum / n as f64;
+        assert!(disp < bound_px, "{name}: {disp} px off");
+        // The map's frame in the merged frame: where its world origin lands, and its yaw.
+        let world = &maps[1]["world"];
+        let own = resampled_pixel(
+            gk.world_to_pixel(DVec2::ZERO),
+            res,
+            gk.height(),
+            r,
+            gb.height(),
+        );
+        let in_merged = merged.pixel_to_world(truth.apply(own));
+        let origin = DVec2::new(world["x"].as_f64().unwrap(), world["y"].as_f64().unwrap());
+        assert!(
+            (origin - in_merged).length() < bound_px * r,
+            "{name}: frame at {origin}, truth {in_merged}"
+        );
+        let yaw_err = grid_core::wrap_angle(world["yaw"].as_f64().unwrap() + truth.theta);
+        assert!(
+            yaw_err.abs().to_degrees() < 0.2,
+            "{name}: yaw {yaw_err} off"
+        );
+    }
+}
+
 #[test]
 fn a_map_that_shares_nothing_with_the_first_is_placed_through_another() {
     let dir = TempDir::new().unwrap();
@@ -338,8 +432,20 @@ fn bad_input_is_refused_with_exit_2_and_inputs_are_never_overwritten() {
         err.contains("--debug-png names one of the merged map's own files"),
         "{err}"
     );
-    let err = fails(&[a_s, s(&fixture("intel_lab")), "-o", out_s]);
-    assert!(err.contains("resolution 0.1 m/cell differs"), "{err}");
+    // A map so coarse that resampling it to the first one's cells would make a huge grid.
+    let coarse =
+        OccupancyGrid::from_cells(20, 10, 100.0, Default::default(), vec![0; 200]).unwrap();
+    let coarse_path = dir.path().join("coarse.yaml");
+    save_map(&coarse, &coarse_path).unwrap();
+    let err = fails(&[a_s, s(&coarse_path), "-o", out_s]);
+    assert_eq!(
+        err,
+        format!(
+            "mapmerge: error: {}: cannot resample it to the first map's resolution: the map \
+             would be 40000 x 20000 cells at 0.05 m/cell, more than 2^28 (268435456)",
+            coarse_path.display()
+        )
+    );
     let missing = dir.path().join("nope.yaml");
     let err = fails(&[a_s, s(&missing), "-o", out_s]);
     assert!(

@@ -84,7 +84,8 @@ pub fn run(args: &EstimateArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode
     if ((ra - rb) / ra).abs() > 1e-6 {
         return Err(UsageError(format!(
             "{}: resolution {rb} m/cell differs from {}'s {ra} m/cell; a rigid pixel transform \
-             needs equal resolutions, so resample one map first",
+             needs equal resolutions (`mapmerge merge A B -o OUT.yaml` resamples B to A's and \
+             reports B's frame in A's)",
             args.b.display(),
             args.a.display()
         ))

@@ -10,7 +10,7 @@ use anyhow::Context;
 use clap::Args;
 use fusion::{EdgeStatus, FusedMap, FusionConfig, FusionRule};
 use grid_core::io::{LoadedMap, image_path_for, save_map, write_atomic};
-use grid_core::{CellState, OccupancyGrid, Rigid2};
+use grid_core::{CellState, GridGeometry, OccupancyGrid, Rigid2};
 use mapmerge::team::{TeamConfig, TeamPair, merge_team};
 use serde_json::{Value, json};
 
@@ -34,16 +34,22 @@ Output:
                       unknown), in the first map's world frame: a point has the same world
                       coordinates in the merged map as in the first map
   OUT.json            the report (also printed by --json):
-    maps              per input: merged (true/false), weight, transform {theta, tx, ty} from
-                      its pixels to the merged map's pixels (x = column, y = row from the top),
-                      world {x, y, yaw}: its map frame in the merged map's frame (metres, yaw
-                      counter-clockwise), ready to publish as a TF; reason when not merged
+    maps              per input: merged (true/false), weight, resolution, transform {theta,
+                      tx, ty, scale} from its pixels to the merged map's pixels (x = column,
+                      y = row from the top; x_out = scale R(theta) x + t, scale 1 unless the
+                      map was resampled), world {x, y, yaw}: its map frame in the merged map's
+                      frame (metres, yaw counter-clockwise), ready to publish as a TF; reason
+                      when not merged
     pairs             per pair a < b: accepted, transform (b's pixels onto a's), confidence,
                       status (tree, loop, dropped, weak: accepted below --min-lift, declined,
                       unreached), residual of the final poses against the pair's answer
                       (rotation_deg, translation_px)
     acceptance_index  agree / (agree + disagree) over every two maps known at the same cell
     overlap_cells, output, timings_ms
+
+Maps of another resolution than the first's are resampled to it (a note on stderr says so):
+a coarser cell takes the highest occupancy of the cells it covers, a finer one repeats its
+cell. The merged map has the first map's resolution.
 
 A map that no such pair links to the first map is left out (a warning on stderr says so)
 and the others are merged. When no map links to the first, nothing is written.
@@ -60,7 +66,7 @@ Examples:
 #[command(after_help = AFTER)]
 pub struct MergeArgs {
     /// The maps (two or more: map_server YAMLs or bare .pgm/.png images). The first is the
-    /// reference: the merged map is in its frame
+    /// reference: the merged map is in its frame, at its resolution
     #[arg(value_name = "MAP", num_args = 2.., required = true)]
     pub maps: Vec<PathBuf>,
     /// The merged map's YAML (.yaml or .yml); its PGM is written beside it with the same name
@@ -172,7 +178,18 @@ pub fn run(args: &MergeArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode> {
         Some(w) => w.clone(),
         None => vec![1.0; args.maps.len()],
     };
-    let maps = load_all(&args.maps, bare)?;
+    let (maps, own) = load_all(&args.maps, bare)?;
+    for (k, g) in own.iter().enumerate() {
+        if !same_resolution(g.resolution, own[0].resolution) {
+            eprintln!(
+                "mapmerge: note: {}: resampled from {} to {} m/cell, the resolution of {}",
+                args.maps[k].display(),
+                g.resolution,
+                own[0].resolution,
+                args.maps[0].display()
+            );
+        }
+    }
     for (out, flag) in &written {
         // A map given by its YAML is read from the image the YAML names.
         refuse_overwriting(out, flag, maps.iter().map(|m| &m.image_path))?;
@@ -259,12 +276,21 @@ pub fn run(args: &MergeArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode> {
     let out_geometry = fused.grid.geometry();
     for (slot, &k) in merged.placed.iter().enumerate() {
         let pose = fused.poses[slot];
+        // Resampling keeps a map's origin, so its frame's pose is the resampled map's.
         let world = pose.to_world(&out_geometry, &maps[k].grid.geometry());
+        let (t, scale) = own_pixels_transform(
+            &pose,
+            own[k].resolution,
+            own[k].height,
+            fused.grid.resolution(),
+            maps[k].grid.height(),
+        );
         map_reports[k] = json!({
             "map": args.maps[k].display().to_string(),
             "merged": true,
             "weight": weights[k],
-            "transform": {"theta": pose.theta, "tx": pose.tx, "ty": pose.ty},
+            "resolution": own[k].resolution,
+            "transform": {"theta": t.theta, "tx": t.tx, "ty": t.ty, "scale": scale},
             "world": {"x": world.tx, "y": world.ty, "yaw": world.theta},
         });
     }
@@ -304,9 +330,14 @@ pub fn run(args: &MergeArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// Load every map, check each has known cells and that all share the first one's resolution.
-fn load_all(paths: &[PathBuf], bare: &BareImageArgs) -> anyhow::Result<Vec<LoadedMap>> {
-    let maps = paths
+/// Load every map and check each has known cells. A map of another resolution than the
+/// first's is resampled to it ([`OccupancyGrid::resample`]); the second value is each map's
+/// own geometry, as read.
+fn load_all(
+    paths: &[PathBuf],
+    bare: &BareImageArgs,
+) -> anyhow::Result<(Vec<LoadedMap>, Vec<GridGeometry>)> {
+    let mut maps = paths
         .iter()
         .map(|p| {
             let m = load(p, bare)?;
@@ -314,20 +345,48 @@ fn load_all(paths: &[PathBuf], bare: &BareImageArgs) -> anyhow::Result<Vec<Loade
             Ok(m)
         })
         .collect::<anyhow::Result<Vec<_>>>()?;
-    let r0 = maps[0].grid.resolution();
-    for (m, p) in maps.iter().zip(paths).skip(1) {
-        let r = m.grid.resolution();
-        if ((r - r0) / r0).abs() > 1e-6 {
-            return Err(UsageError(format!(
-                "{}: resolution {r} m/cell differs from {}'s {r0} m/cell; a rigid pixel \
-                 transform needs equal resolutions, so resample one map first",
-                p.display(),
-                paths[0].display()
-            ))
-            .into());
+    let own: Vec<GridGeometry> = maps.iter().map(|m| m.grid.geometry()).collect();
+    let r0 = own[0].resolution;
+    for (m, p) in maps.iter_mut().zip(paths).skip(1) {
+        if !same_resolution(m.grid.resolution(), r0) {
+            m.grid = m.grid.resample(r0).with_context(|| {
+                format!(
+                    "{}: cannot resample it to the first map's resolution",
+                    p.display()
+                )
+            })?;
         }
     }
-    Ok(maps)
+    Ok((maps, own))
+}
+
+/// Whether two resolutions are the same up to the rounding of a YAML's decimals.
+fn same_resolution(r: f64, r0: f64) -> bool {
+    ((r - r0) / r0).abs() <= 1e-6
+}
+
+/// The transform from the pixels of a map of `own` resolution and `height` rows to the merged
+/// map's, given `pose` from the pixels of the map resampled to the merged map's resolution
+/// (`resampled_height` rows): `x_out = scale R(theta) x + t`, with `scale` 1 when the map was
+/// not resampled. Resampling keeps the lower-left corner, so the map's pixel `p` is the
+/// resampled map's `s p + c` with `s = own / merged resolution`.
+fn own_pixels_transform(
+    pose: &Rigid2,
+    own: f64,
+    height: usize,
+    merged: f64,
+    resampled_height: usize,
+) -> (Rigid2, f64) {
+    if same_resolution(own, merged) {
+        return (*pose, 1.0);
+    }
+    let s = own / merged;
+    let c = grid_core::DVec2::new(
+        0.5 * s - 0.5,
+        resampled_height as f64 - 0.5 - (height as f64 - 0.5) * s,
+    );
+    let t = pose.apply(c);
+    (Rigid2::new(pose.theta, t.x, t.y), s)
 }
 
 fn transform_json(t: &Rigid2) -> Value {

@@ -45,7 +45,8 @@ pub fn exit_code_for(err: &anyhow::Error) -> u8 {
                 | grid_core::Error::Format { .. }
                 | grid_core::Error::AllUnknown { .. }
                 | grid_core::Error::ZeroSize { .. }
-                | grid_core::Error::Resolution(_) => EXIT_BAD_INPUT,
+                | grid_core::Error::Resolution(_)
+                | grid_core::Error::ResampleTooLarge { .. } => EXIT_BAD_INPUT,
                 // Inconsistent buffers can only come from our own code.
                 _ => EXIT_INTERNAL,
             };
