@@ -17,7 +17,9 @@ use indicatif::{ProgressBar, ProgressStyle};
 use mapmerge::search::SearchConfig;
 use mapmerge::verify::{PreparedMap, verify};
 use mapmerge::{Method, RegisterConfig, refine_and_score, register};
-use mapsim::{Case, CaseConfig, RobotConfig, WorldConfig, WorldKind, generate_case};
+use mapsim::{
+    Case, CaseConfig, CropConfig, RobotConfig, WorldConfig, WorldKind, crop_pair, generate_case,
+};
 use rayon::prelude::*;
 
 use crate::r#gen::Mapper;
@@ -29,7 +31,8 @@ pub struct EvalArgs {
     /// Suites to run (comma separated): overlap, zero, noise, mismatch, paper, real, large (the
     /// nav2 warehouse, maps about 1800 x 900 cells; slow to simulate), floors (five real
     /// building floors at 30 % overlap and equal noise, one never tuned on), floorzero (the
-    /// same floors at zero overlap: must decline), or `all`.
+    /// same floors at zero overlap: must decline), crops (the same floors cut in two, the
+    /// parts sharing 30 % or nothing), or `all`.
     #[arg(long, value_delimiter = ',', default_value = "overlap,zero")]
     suites: Vec<String>,
     /// Cases per suite row.
@@ -85,6 +88,11 @@ pub struct EvalArgs {
     /// default: the library's), to measure what it changes.
     #[arg(long)]
     max_wall_contradiction: Option<f64>,
+    /// Override the contradiction bar of clean walls (`mapmerge::verify::CleanWalls`) as
+    /// `BASE,PER_LONE_SHARE` (`off` turns it off; default: the library's), to measure what it
+    /// changes.
+    #[arg(long, value_name = "BASE,PER_LONE_SHARE|off", value_parser = clean_walls_values)]
+    clean_walls: Option<CleanWallsArg>,
     /// Override the wall lift from which an answer's walls count as crisp and are held to the
     /// misfit bar (`mapmerge::VerifyConfig::crisp_wall_lift`; above `1` turns the rule off;
     /// default: the library's), to measure what it changes.
@@ -321,6 +329,10 @@ pub struct EvalArgs {
     /// default.
     #[arg(long, value_enum, default_value = "default")]
     mapper: Mapper,
+    /// Every robot's range noise bound, as a fraction (e.g. 0.05), instead of each row's own
+    /// (robot rows only; the labels say so), to measure a change on maps of other noise.
+    #[arg(long, value_parser = noise_value)]
+    noise: Option<f64>,
     /// Only the rows whose label contains this text (e.g. `"overlap 0.3"`).
     #[arg(long)]
     only: Option<String>,
@@ -414,6 +426,37 @@ where
         .collect()
 }
 
+/// `--noise B`: a noise bound in [0, 1).
+fn noise_value(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(b) if (0.0..1.0).contains(&b) => Ok(b),
+        _ => Err(format!("expected a noise bound in [0, 1), got {s:?}")),
+    }
+}
+
+/// The value of `--clean-walls`: the bar, or `None` for `off`.
+#[derive(Debug, Clone, Copy)]
+struct CleanWallsArg(Option<mapmerge::verify::CleanWalls>);
+
+/// `--clean-walls BASE,PER_LONE_SHARE` or `off`.
+fn clean_walls_values(s: &str) -> Result<CleanWallsArg, String> {
+    if s == "off" {
+        return Ok(CleanWallsArg(None));
+    }
+    let v: Vec<f64> = numbers(s)?;
+    match v.as_slice() {
+        &[base, per_lone_share] if v.iter().all(|g| g.is_finite() && *g >= 0.0) => {
+            Ok(CleanWallsArg(Some(mapmerge::verify::CleanWalls {
+                base,
+                per_lone_share,
+            })))
+        }
+        _ => Err(format!(
+            "expected two numbers >= 0 (BASE,PER_LONE_SHARE) or `off`, got {s:?}"
+        )),
+    }
+}
+
 /// `--stand-out LIFT,MARGIN`: two numbers in [0, 1].
 fn stand_out_values(s: &str) -> Result<(f64, f64), String> {
     let v: Vec<f64> = numbers(s)?;
@@ -425,12 +468,20 @@ fn stand_out_values(s: &str) -> Result<(f64, f64), String> {
     }
 }
 
-/// One row of a suite: a configuration and whether success means declining.
+/// One row of a suite: where its cases come from and whether success means declining.
 struct Row {
     suite: &'static str,
     label: String,
-    config: CaseConfig,
+    source: Source,
     expect_decline: bool,
+}
+
+/// Where a row's cases come from.
+enum Source {
+    /// Two simulated robots (`mapsim::generate_case`).
+    Robots(CaseConfig),
+    /// A real map cut in two (`mapsim::crop_pair`).
+    Crops(Box<OccupancyGrid>, CropConfig),
 }
 
 fn lidar(noise: f64) -> RobotConfig {
@@ -480,7 +531,7 @@ fn must_decline(suite: &'static str, label: String, world: WorldConfig, noise: f
     Row {
         suite,
         label,
-        config,
+        source: Source::Robots(config),
         expect_decline: true,
     }
 }
@@ -498,11 +549,11 @@ fn floor_at_30(suite: &'static str, name: &str) -> Result<Row> {
     Ok(Row {
         suite,
         label: format!("{name} world, overlap 0.3, noise 10%/10%"),
-        config: case(
+        source: Source::Robots(case(
             world(WorldKind::Grid(fixture_floor(name)?), 0),
             vec![lidar(0.10), lidar(0.10)],
             0.3,
-        ),
+        )),
         expect_decline: false,
     })
 }
@@ -521,11 +572,11 @@ fn rows(suites: &[String], size: usize, mapper: Mapper) -> Result<Vec<Row>> {
                 rows.push(Row {
                     suite: "overlap",
                     label: format!("{wname}, overlap {overlap}, noise 10%/10%"),
-                    config: case(
+                    source: Source::Robots(case(
                         world(kind.clone(), size),
                         vec![lidar(0.10), lidar(0.10)],
                         overlap,
-                    ),
+                    )),
                     expect_decline: false,
                 });
             }
@@ -551,11 +602,11 @@ fn rows(suites: &[String], size: usize, mapper: Mapper) -> Result<Vec<Row>> {
                     "disaster, overlap 0.5, noise {0:.0}%/{0:.0}%",
                     noise * 100.0
                 ),
-                config: case(
+                source: Source::Robots(case(
                     world(WorldKind::Disaster, size),
                     vec![lidar(noise), lidar(noise)],
                     0.5,
-                ),
+                )),
                 expect_decline: false,
             });
         }
@@ -565,11 +616,11 @@ fn rows(suites: &[String], size: usize, mapper: Mapper) -> Result<Vec<Row>> {
             rows.push(Row {
                 suite: "mismatch",
                 label: format!("disaster, overlap 0.5, noise 10%/{:.0}%", noise_b * 100.0),
-                config: case(
+                source: Source::Robots(case(
                     world(WorldKind::Disaster, size),
                     vec![lidar(0.10), lidar(noise_b)],
                     0.5,
-                ),
+                )),
                 expect_decline: false,
             });
         }
@@ -580,7 +631,7 @@ fn rows(suites: &[String], size: usize, mapper: Mapper) -> Result<Vec<Row>> {
         rows.push(Row {
             suite: "paper",
             label: "paper preset: 150x150, 16 IR beams, noise 10%/15%".into(),
-            config,
+            source: Source::Robots(config),
             expect_decline: false,
         });
     }
@@ -590,11 +641,11 @@ fn rows(suites: &[String], size: usize, mapper: Mapper) -> Result<Vec<Row>> {
             rows.push(Row {
                 suite: "real",
                 label: format!("{name} world, overlap 0.5, noise 10%/20%"),
-                config: case(
+                source: Source::Robots(case(
                     world(WorldKind::Grid(grid), 0),
                     vec![lidar(0.10), lidar(0.20)],
                     0.5,
-                ),
+                )),
                 expect_decline: false,
             });
         }
@@ -624,7 +675,7 @@ fn rows(suites: &[String], size: usize, mapper: Mapper) -> Result<Vec<Row>> {
         rows.push(Row {
             suite: "paper",
             label: "paper preset at overlap 0.3".into(),
-            config,
+            source: Source::Robots(config),
             expect_decline: false,
         });
     }
@@ -663,11 +714,38 @@ fn rows(suites: &[String], size: usize, mapper: Mapper) -> Result<Vec<Row>> {
             ));
         }
     }
+    if want("crops") {
+        // The same five real floors cut in two along a straight line at a random place, the
+        // second part turned by a random angle: the parts share 30 % of the smaller one's
+        // extent, or nothing (must decline). Crisp walls that coincide where the parts
+        // overlap, as a user who cuts a building map in two would test with. No robots, so
+        // `--mapper` does not apply. Listed last, so that every other row keeps its cases.
+        for overlap in [0.3, 0.0] {
+            for name in FLOORS {
+                let config = CropConfig {
+                    overlap,
+                    ..CropConfig::default()
+                };
+                rows.push(Row {
+                    suite: "crops",
+                    label: if overlap > 0.0 {
+                        format!("{name} cut in two, overlap {overlap}")
+                    } else {
+                        format!("{name} cut in two, overlap 0 (must decline)")
+                    },
+                    source: Source::Crops(Box::new(fixture_floor(name)?), config),
+                    expect_decline: overlap == 0.0,
+                });
+            }
+        }
+    }
     anyhow::ensure!(!rows.is_empty(), "no known suite in {suites:?}");
     if mapper != Mapper::Default {
         for row in &mut rows {
-            row.config.inverse_model = mapper.model();
-            row.label = format!("{}, {} mapper", row.label, mapper.name());
+            if let Source::Robots(config) = &mut row.source {
+                config.inverse_model = mapper.model();
+                row.label = format!("{}, {} mapper", row.label, mapper.name());
+            }
         }
     }
     Ok(rows)
@@ -726,6 +804,9 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
     }
     if let Some(e) = args.max_contradiction_excess {
         config.pair.verify.max_contradiction_excess = e;
+    }
+    if let Some(CleanWallsArg(c)) = args.clean_walls {
+        config.pair.verify.clean_walls = c;
     }
     if let Some(c) = args.max_wall_contradiction {
         config.pair.verify.max_wall_contradiction = c;
@@ -971,8 +1052,52 @@ fn write_picture(case: &Case, best: Option<&Rigid2>, path: &Path) -> Result<()> 
     grid_core::io::write_atomic(path, &png).with_context(|| format!("writing {}", path.display()))
 }
 
+/// One case of a row: two robots' maps, or two parts of a cut map.
+enum CasePair {
+    Robots(Box<Case>),
+    Crops(Box<mapsim::CropPair>),
+}
+
+impl CasePair {
+    fn generate(source: &Source, seed: u64) -> mapsim::Result<Self> {
+        Ok(match source {
+            Source::Robots(config) => Self::Robots(Box::new(generate_case(config, seed)?)),
+            Source::Crops(map, config) => Self::Crops(Box::new(crop_pair(map, config, seed)?)),
+        })
+    }
+
+    fn a(&self) -> &OccupancyGrid {
+        match self {
+            Self::Robots(c) => &c.robots[0].map,
+            Self::Crops(p) => &p.a,
+        }
+    }
+
+    fn b(&self) -> &OccupancyGrid {
+        match self {
+            Self::Robots(c) => &c.robots[1].map,
+            Self::Crops(p) => &p.b,
+        }
+    }
+
+    /// The transform from a pixel of `b` to the same place in `a`.
+    fn truth(&self) -> Rigid2 {
+        match self {
+            Self::Robots(c) => c.truth(0, 1),
+            Self::Crops(p) => p.truth,
+        }
+    }
+
+    fn overlap(&self) -> f64 {
+        match self {
+            Self::Robots(c) => c.achieved_overlap,
+            Self::Crops(p) => p.overlap,
+        }
+    }
+}
+
 /// Generate case `seed` of `row` once and register it with every method; with `pictures`,
-/// draw each method's failure there.
+/// draw each method's failure there (robot cases only).
 fn run_case(
     row: &Row,
     methods: &[Method],
@@ -1003,8 +1128,8 @@ fn run_case(
         truth_refined_verification: None,
         true_correspondences: None,
     };
-    let case = match generate_case(&row.config, seed) {
-        Ok(c) => c,
+    let pair = match CasePair::generate(&row.source, seed) {
+        Ok(p) => p,
         Err(e) => {
             return Ok(methods
                 .iter()
@@ -1015,8 +1140,7 @@ fn run_case(
                 .collect());
         }
     };
-    let (a, b) = (&case.robots[0].map, &case.robots[1].map);
-    let truth = case.truth(0, 1);
+    let (a, b, truth) = (pair.a(), pair.b(), pair.truth());
     // What the verification and the refinement reach at best, started at the truth; the
     // same for every method.
     let (truth_verification, truth_refined_drift_px, truth_refined_verification) =
@@ -1037,7 +1161,7 @@ fn run_case(
         .iter()
         .map(|&method| {
             let mut out = blank(method);
-            out.achieved_overlap = case.achieved_overlap;
+            out.achieved_overlap = pair.overlap();
             out.truth_verification = truth_verification;
             out.truth_refined_drift_px = truth_refined_drift_px;
             out.truth_refined_verification = truth_refined_verification;
@@ -1079,9 +1203,11 @@ fn run_case(
             } else {
                 out.displacement_error_px.is_some_and(|d| d <= 3.0)
             };
-            if let Some(dir) = pictures.filter(|_| !out.success) {
+            if let (Some(dir), CasePair::Robots(case)) = (pictures, &pair)
+                && !out.success
+            {
                 let best = result.candidates.first().map(|c| &c.transform);
-                write_picture(&case, best, &dir.join(format!("{seed}-{method}.png")))?;
+                write_picture(case, best, &dir.join(format!("{seed}-{method}.png")))?;
             }
             Ok(out)
         })
@@ -1122,12 +1248,17 @@ fn export(rows: &[Row], jobs: &[(usize, u64)], dir: &Path, bar: &ProgressBar) ->
         .par_iter()
         .map(|&(r, seed)| {
             let row = &rows[r];
-            let out = match generate_case(&row.config, seed) {
-                Ok(case) => {
+            let out = match CasePair::generate(&row.source, seed) {
+                Ok(pair) => {
                     let folder = format!("{}-{}", row.suite, slug(&row.label));
                     let case_dir = dir.join(folder).join(format!("case_{seed}"));
-                    crate::r#gen::write_case(&case, &row.label, &case_dir)
-                        .with_context(|| format!("writing {}", case_dir.display()))?;
+                    match &pair {
+                        CasePair::Robots(case) => {
+                            crate::r#gen::write_case(case, &row.label, &case_dir)
+                        }
+                        CasePair::Crops(p) => write_crops(p, seed, &row.label, &case_dir),
+                    }
+                    .with_context(|| format!("writing {}", case_dir.display()))?;
                     None
                 }
                 Err(e) => Some(format!("{} seed {seed}: {e}", row.label)),
@@ -1151,9 +1282,39 @@ fn export(rows: &[Row], jobs: &[(usize, u64)], dir: &Path, bar: &ProgressBar) ->
     Ok(())
 }
 
+/// `--export` of a cut map's pair: `robot_0.yaml` (the first part), `robot_1.yaml` (the
+/// second, turned) and `truth.json` with the transform from the second's pixels to the first's.
+fn write_crops(pair: &mapsim::CropPair, seed: u64, label: &str, dir: &Path) -> Result<()> {
+    std::fs::create_dir_all(dir)?;
+    grid_core::io::save_map(&pair.a, &dir.join("robot_0.yaml"))?;
+    grid_core::io::save_map(&pair.b, &dir.join("robot_1.yaml"))?;
+    let truth = serde_json::json!({
+        "seed": seed,
+        "row": label,
+        "convention": "transform maps a pixel of map b onto map a (x column, y row from top)",
+        "pairs": [{"a": 0, "b": 1, "transform": pair.truth}],
+        "overlap": pair.overlap,
+    });
+    grid_core::io::write_atomic(
+        &dir.join("truth.json"),
+        format!("{}\n", serde_json::to_string_pretty(&truth)?).as_bytes(),
+    )?;
+    Ok(())
+}
+
 /// Run `cargo xtask eval`.
 pub fn run(args: EvalArgs) -> Result<()> {
-    let rows = rows(&args.suites, args.size, args.mapper)?;
+    let mut rows = rows(&args.suites, args.size, args.mapper)?;
+    if let Some(noise) = args.noise {
+        for row in &mut rows {
+            if let Source::Robots(config) = &mut row.source {
+                for robot in &mut config.robots {
+                    robot.noise_bound = noise;
+                }
+                row.label = format!("{}, every noise set to {:.0}%", row.label, noise * 100.0);
+            }
+        }
+    }
     let defaults = register_config(&args);
     // A row keeps its index among the selected suites' rows with or without `--only`, so the
     // filtered run draws the same cases as the full one.
@@ -1286,7 +1447,7 @@ pub fn run(args: EvalArgs) -> Result<()> {
 
 #[cfg(test)]
 mod tests {
-    use super::{Row, angle_window, export, grey_values, slug, stand_out_values};
+    use super::{Row, Source, angle_window, export, grey_values, slug, stand_out_values};
     use grid_core::io::{LoadOptions, load_map};
     use mapsim::{CaseConfig, generate_case};
 
@@ -1313,7 +1474,7 @@ mod tests {
         let rows = [Row {
             suite: "paper",
             label: "paper preset".into(),
-            config: config.clone(),
+            source: Source::Robots(config.clone()),
             expect_decline: false,
         }];
         let dir = tempfile::tempdir().unwrap();
@@ -1358,6 +1519,46 @@ mod tests {
                     }
                 }
             }
+        }
+    }
+
+    #[test]
+    fn export_writes_a_cut_maps_pair_with_its_truth() {
+        let floor = super::fixture_floor("aws_small_house").unwrap();
+        let config = mapsim::CropConfig::default();
+        let rows = [Row {
+            suite: "crops",
+            label: "aws cut".into(),
+            source: Source::Crops(Box::new(floor.clone()), config),
+            expect_decline: false,
+        }];
+        let dir = tempfile::tempdir().unwrap();
+        export(
+            &rows,
+            &[(0, 5)],
+            dir.path(),
+            &indicatif::ProgressBar::hidden(),
+        )
+        .unwrap();
+        let case_dir = dir.path().join("crops-aws_cut/case_5");
+        let pair = mapsim::crop_pair(&floor, &config, 5).unwrap();
+        let truth: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(case_dir.join("truth.json")).unwrap()).unwrap();
+        assert_eq!(truth["seed"], 5);
+        let t = &truth["pairs"][0]["transform"];
+        let got = [&t["theta"], &t["tx"], &t["ty"]].map(|v| v.as_f64().unwrap());
+        let want = [pair.truth.theta, pair.truth.tx, pair.truth.ty];
+        for (g, w) in got.iter().zip(want) {
+            assert!((g - w).abs() <= 1e-12 * w.abs().max(1.0), "{g} vs {w}");
+        }
+        for (k, map) in [&pair.a, &pair.b].into_iter().enumerate() {
+            let read = load_map(
+                case_dir.join(format!("robot_{k}.yaml")),
+                &LoadOptions::default(),
+            )
+            .unwrap();
+            assert_eq!((read.width(), read.height()), (map.width(), map.height()));
+            assert_eq!(read.counts(), map.counts());
         }
     }
 

@@ -21,9 +21,11 @@ Sets (20 cases per row, as in docs/EVALUATION.md):
   large   the nav2 warehouse, seeds 7, 8                  largeh  hector's, seed 8
   floors  five real floors at 30 % overlap, seeds 7, 8
   floorzero  the same floors at zero overlap (must decline), seed 7
+  crops   the same floors cut in two, sharing 30 % or nothing (must decline), seed 7
 All of them but floors took 19 minutes on a 2-core Intel Xeon VM (2026-12-05); floors
 took 4 minutes a seed there. In a faster hour of that VM the whole batch, floors included,
-took 20 minutes (2026-12-05, 18:42-19:02 UTC); floorzero took 1 minute (22:14 UTC).
+took 20 minutes (2026-12-05, 18:42-19:02 UTC); floorzero took 1 minute (22:14 UTC), crops
+3 minutes (23:31 UTC, beside another eval).
 
 Examples:
   cargo xtask regress --out /tmp/before
@@ -131,6 +133,13 @@ const SETS: &[Set] = &[
     Set {
         name: "floorzero",
         suites: "floorzero",
+        only: None,
+        hector: false,
+        seeds: &[7],
+    },
+    Set {
+        name: "crops",
+        suites: "crops",
         only: None,
         hector: false,
         seeds: &[7],
@@ -263,7 +272,8 @@ mod tests {
                 "largeh_8",
                 "floors_7",
                 "floors_8",
-                "floorzero_7"
+                "floorzero_7",
+                "crops_7"
             ]
         );
         for (_, argv) in &runs {

@@ -1370,6 +1370,20 @@ fn register_as_given(
             );
             return declined(reason, timings, candidates);
         }
+        if let Some(clean) = &config.verify.clean_walls {
+            let (sa, sb) = rayon::join(|| lone_wall_share(pa.grid), || lone_wall_share(pb.grid));
+            let bar = clean.bar(sa, sb);
+            if v.mutual_contradiction > bar {
+                let reason = format!(
+                    "contradicted: each map puts {:.1} % or more of its compared walls in the other's free space, where maps with walls this clean (lone wall cells {:.1} % and {:.1} %) allow {:.1} %",
+                    100.0 * v.mutual_contradiction,
+                    100.0 * sa,
+                    100.0 * sb,
+                    100.0 * bar
+                );
+                return declined(reason, timings, candidates);
+            }
+        }
         if let Some(bar) = v.crisp_contradiction_bar(&config.verify)
             && v.mutual_contradiction > bar
         {

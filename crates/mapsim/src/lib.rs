@@ -42,6 +42,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
+mod crops;
 mod overlap;
 mod planner;
 mod raycast;
@@ -50,6 +51,7 @@ mod sensor;
 pub mod strategies;
 mod world;
 
+pub use crops::{CropConfig, CropPair, crop_pair};
 pub use world::{World, WorldConfig, WorldKind};
 
 /// Result alias of this crate.

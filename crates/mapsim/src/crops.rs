@@ -1,0 +1,227 @@
+//! Pairs cut from one map: the crisp-walled pairs someone makes by cutting a real building map
+//! in two, turning one part and asking for the transform back.
+//!
+//! Unlike the robots of [`crate::generate_case`], the two maps hold the same cells where they
+//! overlap, so a right answer fits almost every wall and a placement that lays one room on
+//! another shows as walls in the other map's free space. With no overlap, a pair cut along a
+//! straight line is what a tool must decline although its parts look alike (rooms repeat).
+
+use std::f64::consts::PI;
+
+use glam::DVec2;
+use grid_core::{CellState, OccupancyGrid, Rigid2, UNKNOWN};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+use crate::{Error, Result};
+
+/// How a map is cut into a pair, with documented defaults.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CropConfig {
+    /// Share of the smaller part's extent across the cut that both parts hold, in `[0, 1)`.
+    /// Default 0.3.
+    pub overlap: f64,
+    /// Where the cut lies across the known cells' extent, as a fraction drawn uniformly from
+    /// this range. Default `(0.35, 0.65)`.
+    pub cut: (f64, f64),
+    /// Unknown cells around each part's known cells. Default 10.
+    pub margin: usize,
+}
+
+impl Default for CropConfig {
+    fn default() -> Self {
+        Self {
+            overlap: 0.3,
+            cut: (0.35, 0.65),
+            margin: 10,
+        }
+    }
+}
+
+/// Two parts of one map with the transform between them.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CropPair {
+    /// The first part, unturned: the map's region around its known cells, the other cells
+    /// unknown.
+    pub a: OccupancyGrid,
+    /// The second part, turned by a random angle about its middle (nearest-neighbour
+    /// resampling) on a square canvas that holds any turn.
+    pub b: OccupancyGrid,
+    /// Maps a pixel of `b` onto the same place in `a`.
+    pub truth: Rigid2,
+    /// Known cells of the map in both parts over those of the smaller part (before `b` is
+    /// turned).
+    pub overlap: f64,
+    /// Whether the cut runs along columns (the parts are west and east) rather than rows.
+    pub vertical_cut: bool,
+    /// The angle `b` was turned by, radians.
+    pub angle: f64,
+}
+
+/// Cut `map` across its known cells at a random place, along a random axis, into two parts
+/// that share `config.overlap` of the smaller one's extent; turn the second by a random angle.
+/// Deterministic for a given seed.
+pub fn crop_pair(map: &OccupancyGrid, config: &CropConfig, seed: u64) -> Result<CropPair> {
+    let (lo, hi) = config.cut;
+    let valid = (0.0..1.0).contains(&config.overlap) && 0.0 < lo && lo <= hi && hi < 1.0;
+    if !valid {
+        return Err(Error::Config(format!(
+            "crop overlap {} must lie in [0, 1) and the cut range {:?} within (0, 1)",
+            config.overlap, config.cut
+        )));
+    }
+    let Some((x0, y0, w, h)) = map.known_bounds(0) else {
+        return Err(Error::Config("the map to crop has no known cell".into()));
+    };
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let vertical_cut = rng.random::<bool>();
+    let cut = rng.random_range(lo..=hi);
+    let angle = rng.random_range(-PI..PI);
+    // The band both parts hold, as fractions of the extent across the cut: `overlap` of the
+    // smaller part's extent, `min(cut, 1 - cut) + band / 2`.
+    let smaller = cut.min(1.0 - cut);
+    let band = config.overlap * smaller / (1.0 - config.overlap / 2.0);
+    let extent = if vertical_cut { w } else { h } as f64;
+    let across = |x: usize, y: usize| {
+        let (v, start) = if vertical_cut { (x, x0) } else { (y, y0) };
+        (v as f64 - start as f64 + 0.5) / extent
+    };
+    let in_a = |x: usize, y: usize| across(x, y) < cut + band / 2.0;
+    let in_b = |x: usize, y: usize| across(x, y) >= cut - band / 2.0;
+    let part = |keep: &dyn Fn(usize, usize) -> bool| {
+        let mut p = map.clone();
+        let width = map.width();
+        for (i, cell) in p.cells_mut().iter_mut().enumerate() {
+            if !keep(i % width, i / width) {
+                *cell = UNKNOWN;
+            }
+        }
+        p
+    };
+    let (mut known_a, mut known_b, mut shared) = (0usize, 0usize, 0usize);
+    for y in y0..y0 + h {
+        for x in x0..x0 + w {
+            if map.state(x, y) == CellState::Unknown {
+                continue;
+            }
+            let (ka, kb) = (in_a(x, y), in_b(x, y));
+            known_a += usize::from(ka);
+            known_b += usize::from(kb);
+            shared += usize::from(ka && kb);
+        }
+    }
+    if known_a == 0 || known_b == 0 {
+        return Err(Error::Config(
+            "a part of the cut map has no known cell".into(),
+        ));
+    }
+    let m = config.margin as i64;
+    let a = part(&in_a)
+        .region(
+            x0 as i64 - m,
+            y0 as i64 - m,
+            w + 2 * config.margin,
+            h + 2 * config.margin,
+        )
+        .map_err(|e| Error::Config(e.to_string()))?;
+    let map_to_a = Rigid2::new(0.0, (m - x0 as i64) as f64, (m - y0 as i64) as f64);
+    // The second part turned about the middle of the known cells, onto a canvas whose middle
+    // that becomes.
+    let side = (w as f64).hypot(h as f64).ceil() as usize + 2 * config.margin;
+    let middle = DVec2::new(x0 as f64 + w as f64 / 2.0, y0 as f64 + h as f64 / 2.0);
+    let half = (side / 2) as f64;
+    let map_to_b = Rigid2::new(angle, half, half).compose(&Rigid2::new(0.0, -middle.x, -middle.y));
+    let b = part(&in_b)
+        .warp(&map_to_b, side, side)
+        .map_err(|e| Error::Config(e.to_string()))?;
+    Ok(CropPair {
+        a,
+        b,
+        truth: map_to_a.compose(&map_to_b.inverse()),
+        overlap: shared as f64 / known_a.min(known_b) as f64,
+        vertical_cut,
+        angle,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use grid_core::Pose2;
+
+    /// A 60 x 40 map: free everywhere, a wall along each side and a few posts.
+    fn room() -> OccupancyGrid {
+        let (w, h) = (60, 40);
+        let mut cells = vec![0u8; w * h];
+        for y in 0..h {
+            for x in 0..w {
+                if x == 0 || y == 0 || x == w - 1 || y == h - 1 || (x % 13 == 5 && y % 11 == 4) {
+                    cells[y * w + x] = 100;
+                }
+            }
+        }
+        OccupancyGrid::from_cells(w, h, 0.05, Pose2::default(), cells).unwrap()
+    }
+
+    #[test]
+    fn the_truth_takes_every_known_cell_of_b_onto_the_same_cell_of_a_where_both_hold_it() {
+        let map = room();
+        for seed in 0..20 {
+            let pair = crop_pair(&map, &CropConfig::default(), seed).unwrap();
+            // The turned part's cells came from the map by nearest neighbour: where the truth
+            // lands a known cell of b on a known cell of a, both hold the same map cell.
+            let (mut compared, mut same) = (0usize, 0usize);
+            for y in 0..pair.b.height() {
+                for x in 0..pair.b.width() {
+                    let Some(v) = pair.b.get(x, y).filter(|&v| v != UNKNOWN) else {
+                        continue;
+                    };
+                    let q = pair.truth.apply(DVec2::new(x as f64, y as f64)).round();
+                    if let Some(u) = pair.a.get(q.x as usize, q.y as usize)
+                        && u != UNKNOWN
+                        && q.x >= 0.0
+                        && q.y >= 0.0
+                    {
+                        compared += 1;
+                        same += usize::from(u == v);
+                    }
+                }
+            }
+            assert!(compared > 0, "seed {seed}: nothing shared");
+            assert!(
+                same as f64 >= 0.97 * compared as f64,
+                "seed {seed}: {same} of {compared}"
+            );
+            assert!(
+                (0.2..0.45).contains(&pair.overlap),
+                "seed {seed}: {}",
+                pair.overlap
+            );
+        }
+    }
+
+    #[test]
+    fn with_no_overlap_the_parts_share_no_cell_and_a_seed_gives_the_same_pair() {
+        let map = room();
+        let config = CropConfig {
+            overlap: 0.0,
+            ..CropConfig::default()
+        };
+        for seed in 0..20 {
+            let pair = crop_pair(&map, &config, seed).unwrap();
+            assert_eq!(pair.overlap, 0.0, "seed {seed}");
+            assert_eq!(pair, crop_pair(&map, &config, seed).unwrap());
+        }
+        assert!(matches!(
+            crop_pair(
+                &map,
+                &CropConfig {
+                    overlap: 1.0,
+                    ..config
+                },
+                1
+            ),
+            Err(Error::Config(_))
+        ));
+    }
+}
