@@ -244,6 +244,16 @@ fn maps_of_other_resolutions_are_resampled_to_the_first_ones() {
     }
 }
 
+/// Each pair's status in a merge report, in the report's order.
+fn statuses(report: &serde_json::Value) -> Vec<&str> {
+    report["pairs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p["status"].as_str().unwrap())
+        .collect()
+}
+
 #[test]
 fn a_map_that_shares_nothing_with_the_first_is_placed_through_another() {
     let dir = TempDir::new().unwrap();
@@ -279,13 +289,8 @@ fn a_map_that_shares_nothing_with_the_first_is_placed_through_another() {
         String::from_utf8_lossy(&o.stderr)
     );
     let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-    let pairs = report["pairs"].as_array().unwrap();
-    let status: Vec<&str> = pairs
-        .iter()
-        .map(|p| p["status"].as_str().unwrap())
-        .collect();
-    assert_eq!(status, ["tree", "declined", "tree"], "{report}");
-    let why = pairs[1]["reason"].as_str().unwrap();
+    assert_eq!(statuses(&report), ["tree", "declined", "tree"], "{report}");
+    let why = report["pairs"][1]["reason"].as_str().unwrap();
     assert!(why.starts_with("contradicted: "), "{why}");
     let maps = &report["maps"];
     let reference = transform(&maps[0]["transform"]);
@@ -309,13 +314,7 @@ fn a_map_that_shares_nothing_with_the_first_is_placed_through_another() {
     ]);
     assert_eq!(o.status.code(), Some(3));
     let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-    let status: Vec<&str> = report["pairs"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|p| p["status"].as_str().unwrap())
-        .collect();
-    assert_eq!(status, ["weak", "declined", "weak"], "{report}");
+    assert_eq!(statuses(&report), ["weak", "declined", "weak"], "{report}");
     assert!(!out.exists() && !out.with_extension("json").exists());
 }
 
