@@ -236,6 +236,14 @@ fn maps_of_other_resolutions_are_resampled_to_the_first_ones() {
             (origin - in_merged).length() < bound_px * r,
             "{name}: frame at {origin}, truth {in_merged}"
         );
+        // The text report shows the scale too.
+        let text_out = dir.path().join(format!("{name}_text.yaml"));
+        let o = merge(&[s(&a), s(&path), "-o", s(&text_out)]);
+        let text = String::from_utf8_lossy(&o.stdout);
+        assert!(
+            text.contains(&format!(", scale {scale}), weight")),
+            "{text}"
+        );
         let yaw_err = grid_core::wrap_angle(world["yaw"].as_f64().unwrap() + truth.theta);
         assert!(
             yaw_err.abs().to_degrees() < 0.2,

@@ -496,9 +496,13 @@ fn human(w: &mut impl Write, r: &Value) -> std::io::Result<()> {
         }
         let (t, wd) = (&m["transform"], &m["world"]);
         let f = |v: &Value| v.as_f64().unwrap_or(f64::NAN);
+        let scale = match t["scale"].as_f64() {
+            Some(s) if s != 1.0 => format!(", scale {s}"),
+            _ => String::new(),
+        };
         writeln!(
             w,
-            "  {name}{}: frame at x {:.3} m, y {:.3} m, yaw {:.3} deg (pixels: theta {:.3} deg, tx {:.2}, ty {:.2}), weight {}",
+            "  {name}{}: frame at x {:.3} m, y {:.3} m, yaw {:.3} deg (pixels: theta {:.3} deg, tx {:.2}, ty {:.2}{scale}), weight {}",
             if k == 0 { " (reference)" } else { "" },
             f(&wd["x"]),
             f(&wd["y"]),
