@@ -5,7 +5,8 @@
 //! robot's partial occupancy map in its own randomly rotated and shifted frame, together with
 //! the exact pixel transforms between the maps ([`Case::truth`]) and the achieved overlap of
 //! their explored areas. The registration crates use [`strategies`] in property tests and the
-//! evaluation harness uses [`generate_case`] to build suites.
+//! evaluation harness uses [`generate_case`] to build suites. It also cuts one map into two
+//! parts with known truth ([`crop_pair`]): crisp-walled pairs without robots.
 //!
 //! It is not for: SLAM (poses are perfect; only ranges are noisy), registration, or map I/O.
 //!

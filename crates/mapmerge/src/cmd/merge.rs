@@ -245,11 +245,13 @@ pub fn run(args: &MergeArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode> {
         .maps
         .iter()
         .zip(&weights)
-        .map(|(path, w)| {
+        .zip(&own)
+        .map(|((path, w), g)| {
             json!({
                 "map": path.display().to_string(),
                 "merged": false,
                 "weight": w,
+                "resolution": g.resolution,
                 "transform": null,
                 "world": null,
                 "reason": format!(
