@@ -1,7 +1,8 @@
 //! `cargo xtask eval`: accuracy, decline rate and time of registration on suites anyone can
 //! regenerate from a seed.
 //!
-//! Each suite is a family of simulated two-robot cases (mapsim) with known truth. A case is a
+//! Each suite is a family of simulated two-robot cases (mapsim) with known truth, or of real
+//! floors cut in two (`mapsim::crop_pair`; not drawn by `--pictures`). A case is a
 //! success when the pair is accepted and the displacement error (mean over B's known cells of
 //! `|T_est(p) - T_true(p)|`) is at most 3 px, as the project's conventions define; in the
 //! zero-overlap suite, a success is a decline.
