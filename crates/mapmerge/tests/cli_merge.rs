@@ -252,6 +252,78 @@ fn maps_of_other_resolutions_are_resampled_to_the_first_ones() {
     }
 }
 
+/// A map's pixel `p` taken to the merged map's pixels by its report entry's transform
+/// (`scale R(theta) p + t`).
+fn to_merged(entry: &serde_json::Value, p: DVec2) -> DVec2 {
+    let t = &entry["transform"];
+    let scale = t["scale"].as_f64().unwrap();
+    let pose = transform(t);
+    DVec2::new(pose.tx, pose.ty) + scale * DVec2::from_angle(pose.theta).rotate(p)
+}
+
+#[test]
+fn the_merged_map_can_have_another_resolution_than_the_first_one() {
+    let dir = TempDir::new().unwrap();
+    let floor = load_map(fixture("intel_lab"), &LoadOptions::default()).unwrap();
+    let (w, r) = (floor.width(), floor.resolution());
+    let to = [turned(&floor, 0.0), turned(&floor, 30.0)];
+    let (a, ga) = crop(&dir, "west", &floor, |x, _| x < w * 6 / 10, to[0]);
+    let (_, gb) = crop(&dir, "east", &floor, |x, _| x >= w * 4 / 10, to[1]);
+    // The east crop mapped at 0.05 m/cell; the merged map at that resolution, so the first
+    // map is the one resampled.
+    let fine = gb.resample(r / 2.0).unwrap();
+    let path = dir.path().join("east_fine.yaml");
+    save_map(&fine, &path).unwrap();
+    let out = dir.path().join("fine_team.yaml");
+    let o = merge(&[
+        s(&a),
+        s(&path),
+        "-o",
+        s(&out),
+        "--json",
+        "--output-resolution",
+        "0.05",
+    ]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{stderr}");
+    assert_eq!(
+        stderr.trim_end(),
+        format!(
+            "mapmerge: note: {}: resampled from {r} to 0.05 m/cell, the --output-resolution",
+            a.display()
+        )
+    );
+    let merged = load_map(&out, &LoadOptions::default()).unwrap();
+    assert_eq!(merged.resolution(), 0.05);
+    let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let maps = report["maps"].as_array().unwrap();
+    assert_eq!(maps[0]["transform"]["scale"].as_f64(), Some(2.0));
+    assert_eq!(maps[1]["transform"]["scale"].as_f64(), Some(1.0));
+    // The first map's cells keep their world coordinates.
+    let p = DVec2::new(200.0, 300.0);
+    let q = merged.world_to_pixel(ga.pixel_to_world(p));
+    assert!((q - to_merged(&maps[0], p)).length() < 1e-6, "{q}");
+    // The east map's known cells land where the truth puts them: its own pixel -> the crop at
+    // 0.1 m/cell -> floor -> west crop -> merged map.
+    let truth = to[0].compose(&to[1].inverse());
+    let (mut sum, mut n) = (0.0, 0usize);
+    for y in (0..fine.height()).step_by(3) {
+        for x in (0..fine.width()).step_by(3) {
+            if fine.state(x, y) == CellState::Unknown {
+                continue;
+            }
+            let p = DVec2::new(x as f64, y as f64);
+            let in_crop = resampled_pixel(p, r / 2.0, fine.height(), r, gb.height());
+            let want = to_merged(&maps[0], truth.apply(in_crop));
+            sum += (to_merged(&maps[1], p) - want).length();
+            n += 1;
+        }
+    }
+    // In the merged map's cells of 0.05 m (measured: 0.17).
+    let disp = sum / n as f64;
+    assert!(disp < 0.5, "{disp} px off");
+}
+
 /// Each pair's status in a merge report, in the report's order.
 fn statuses(report: &serde_json::Value) -> Vec<&str> {
     report["pairs"]
@@ -458,8 +530,8 @@ fn bad_input_is_refused_with_exit_2_and_inputs_are_never_overwritten() {
     assert_eq!(
         err,
         format!(
-            "mapmerge: error: {}: cannot resample it to the first map's resolution: the map \
-             would be 40000 x 20000 cells at 0.05 m/cell, more than 2^28 (268435456)",
+            "mapmerge: error: {}: cannot resample it to 0.05 m/cell: the map would be 40000 x \
+             20000 cells at 0.05 m/cell, more than 2^28 (268435456)",
             coarse_path.display()
         )
     );

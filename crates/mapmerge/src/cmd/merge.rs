@@ -47,9 +47,9 @@ Output:
     acceptance_index  agree / (agree + disagree) over every two maps known at the same cell
     overlap_cells, output, timings_ms
 
-Maps of another resolution than the first's are resampled to it (a note on stderr says so):
-a coarser cell takes the highest occupancy of the cells it covers, a finer one repeats its
-cell. The merged map has the first map's resolution.
+The merged map has the first map's resolution, or --output-resolution's. Maps of another
+resolution are resampled to it (a note on stderr says so): a coarser cell takes the highest
+occupancy of the cells it covers, a finer one repeats its cell.
 
 A map that no such pair links to the first map is left out (a warning on stderr says so)
 and the others are merged. When no map links to the first, nothing is written.
@@ -66,7 +66,8 @@ Examples:
 #[command(after_help = AFTER)]
 pub struct MergeArgs {
     /// The maps (two or more: map_server YAMLs or bare .pgm/.png images). The first is the
-    /// reference: the merged map is in its frame, at its resolution
+    /// reference: the merged map is in its frame (and at its resolution, unless
+    /// --output-resolution says otherwise)
     #[arg(value_name = "MAP", num_args = 2.., required = true)]
     pub maps: Vec<PathBuf>,
     /// The merged map's YAML (.yaml or .yml); its PGM is written beside it with the same name
@@ -86,6 +87,10 @@ pub struct MergeArgs {
     /// spoils the merged map, one left out is reported; 0 uses every pair `estimate` accepts
     #[arg(long, value_name = "LIFT", default_value_t = 0.75, value_parser = super::probability)]
     pub min_lift: f64,
+    /// Metres per cell of the merged map: every map of another resolution is resampled to it
+    /// [default: the first map's]
+    #[arg(long, value_name = "M", value_parser = super::positive_finite)]
+    pub output_resolution: Option<f64>,
     /// Print the report as one JSON object instead of text
     #[arg(long)]
     pub json: bool,
@@ -178,15 +183,18 @@ pub fn run(args: &MergeArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode> {
         Some(w) => w.clone(),
         None => vec![1.0; args.maps.len()],
     };
-    let (maps, own) = load_all(&args.maps, bare)?;
+    let (maps, own) = load_all(&args.maps, bare, args.output_resolution)?;
+    let resolution = maps[0].grid.resolution();
     for (k, g) in own.iter().enumerate() {
-        if !same_resolution(g.resolution, own[0].resolution) {
+        if !same_resolution(g.resolution, resolution) {
+            let whose = match args.output_resolution {
+                Some(_) => "the --output-resolution".to_string(),
+                None => format!("the resolution of {}", args.maps[0].display()),
+            };
             eprintln!(
-                "mapmerge: note: {}: resampled from {} to {} m/cell, the resolution of {}",
+                "mapmerge: note: {}: resampled from {} to {resolution} m/cell, {whose}",
                 args.maps[k].display(),
                 g.resolution,
-                own[0].resolution,
-                args.maps[0].display()
             );
         }
     }
@@ -332,12 +340,13 @@ pub fn run(args: &MergeArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// Load every map and check each has known cells. A map of another resolution than the
-/// first's is resampled to it ([`OccupancyGrid::resample`]); the second value is each map's
-/// own geometry, as read.
+/// Load every map and check each has known cells. A map of another resolution than `output`
+/// (by default the first map's) is resampled to it ([`OccupancyGrid::resample`]); the second
+/// value is each map's own geometry, as read.
 fn load_all(
     paths: &[PathBuf],
     bare: &BareImageArgs,
+    output: Option<f64>,
 ) -> anyhow::Result<(Vec<LoadedMap>, Vec<GridGeometry>)> {
     let mut maps = paths
         .iter()
@@ -348,15 +357,13 @@ fn load_all(
         })
         .collect::<anyhow::Result<Vec<_>>>()?;
     let own: Vec<GridGeometry> = maps.iter().map(|m| m.grid.geometry()).collect();
-    let r0 = own[0].resolution;
-    for (m, p) in maps.iter_mut().zip(paths).skip(1) {
+    let r0 = output.unwrap_or(own[0].resolution);
+    for (m, p) in maps.iter_mut().zip(paths) {
         if !same_resolution(m.grid.resolution(), r0) {
-            m.grid = m.grid.resample(r0).with_context(|| {
-                format!(
-                    "{}: cannot resample it to the first map's resolution",
-                    p.display()
-                )
-            })?;
+            m.grid = m
+                .grid
+                .resample(r0)
+                .with_context(|| format!("{}: cannot resample it to {r0} m/cell", p.display()))?;
         }
     }
     Ok((maps, own))
