@@ -40,7 +40,8 @@ Output:
                       map was resampled), world {x, y, yaw}: its map frame in the merged map's
                       frame (metres, yaw counter-clockwise), ready to publish as a TF; reason
                       when not merged
-    pairs             per pair a < b: accepted, transform (b's pixels onto a's), confidence,
+    pairs             per pair a < b: accepted, transform (b's pixels onto a's, both as
+                      resampled to the merged map's resolution), confidence,
                       status (tree, loop, dropped, weak: accepted below --min-lift, declined,
                       unreached), residual of the final poses against the pair's answer
                       (rotation_deg, translation_px)
