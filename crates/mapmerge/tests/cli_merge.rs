@@ -324,6 +324,69 @@ fn the_merged_map_can_have_another_resolution_than_the_first_one() {
     assert!(disp < 0.5, "{disp} px off");
 }
 
+#[test]
+fn the_reference_can_be_any_of_the_maps() {
+    let dir = TempDir::new().unwrap();
+    let floor = load_map(fixture("intel_lab"), &LoadOptions::default()).unwrap();
+    let w = floor.width();
+    let to = [turned(&floor, 0.0), turned(&floor, 30.0)];
+    let (a, ga) = crop(&dir, "west", &floor, |x, _| x < w * 6 / 10, to[0]);
+    let (b, _) = crop(&dir, "east", &floor, |x, _| x >= w * 4 / 10, to[1]);
+    let out = dir.path().join("east_frame.yaml");
+    // The east crop by another path to the same file.
+    let east_too = format!("{}/./east.yaml", dir.path().display());
+    let o = merge(&[
+        s(&a),
+        s(&b),
+        "-o",
+        s(&out),
+        "--json",
+        "--reference",
+        &east_too,
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(report["reference"], s(&b));
+    let maps = report["maps"].as_array().unwrap();
+    // The east crop is only shifted, and its frame is the merged map's.
+    let reference = transform(&maps[1]["transform"]);
+    assert_eq!(reference.theta, 0.0);
+    for key in ["x", "y", "yaw"] {
+        let v = maps[1]["world"][key].as_f64().unwrap();
+        assert!(v.abs() < 1e-9, "{key} {v}");
+    }
+    let truth = reference.compose(&to[1]).compose(&to[0].inverse());
+    let pose = transform(&maps[0]["transform"]);
+    let disp = displacement_error(&ga, &pose, &truth).unwrap();
+    assert!(disp < 0.5, "west crop {disp} px off");
+    // The text report marks it.
+    let o = merge(&[
+        s(&a),
+        s(&b),
+        "-o",
+        s(&dir.path().join("text.yaml")),
+        "--reference",
+        s(&b),
+    ]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        text.contains(&format!("  {} (reference): ", s(&b))),
+        "{text}"
+    );
+    // A reference that is not one of the maps.
+    let o = merge(&[s(&a), s(&b), "-o", s(&out), "--reference", "nope.yaml"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert_eq!(
+        String::from_utf8_lossy(&o.stderr).trim_end(),
+        "mapmerge: error: nope.yaml: --reference must be one of the maps given"
+    );
+}
+
 /// Each pair's status in a merge report, in the report's order.
 fn statuses(report: &serde_json::Value) -> Vec<&str> {
     report["pairs"]

@@ -1,5 +1,6 @@
 //! `mapmerge merge MAP MAP... -o OUT.yaml`: register every pair of maps, solve one pose per map
-//! in the first map's frame, fuse the maps into one, and report every map's pose.
+//! in the reference map's frame (the first, or `--reference`), fuse the maps into one, and
+//! report every map's pose.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -22,17 +23,17 @@ const AFTER: &str = "\
 How it works: every pair of maps is registered as `mapmerge estimate` does (n maps: n(n-1)/2
 pairs, in parallel). The pairs accepted at wall lift --min-lift or more form a graph; a
 spanning tree of the answers that rest on the most agreeing walls (large overlaps first)
-places every map it reaches in the first map's frame, and the answers that close loops
-refine those poses by least squares (an answer that disagrees with the tree by more than 3
-degrees or 8 px is dropped as wrong). The placed maps are then fused: where one map alone
+places every map it reaches in the reference map's frame (the first map, or --reference),
+and the answers that close loops refine those poses by least squares (an answer that
+disagrees with the tree by more than 3 degrees or 8 px is dropped as wrong). The placed maps are then fused: where one map alone
 is known it keeps its cell; where several are, the cell takes their occupancy probabilities'
 mean weighted by --weights (the paper's alpha * M1 + beta * M2, alpha + beta = 1), or with
 --rule occupied-wins the wall any map saw.
 
 Output:
   OUT.yaml + OUT.pgm  the merged map, as map_saver writes it (0 occupied, 254 free, 205
-                      unknown), in the first map's world frame: a point has the same world
-                      coordinates in the merged map as in the first map
+                      unknown), in the reference map's world frame: a point has the same
+                      world coordinates in the merged map as in the reference map
   OUT.json            the report (also printed by --json):
     maps              per input: merged (true/false), weight, resolution, transform {theta,
                       tx, ty, scale} from its pixels to the merged map's pixels (x = column,
@@ -41,34 +42,35 @@ Output:
                       frame (metres, yaw counter-clockwise), ready to publish as a TF; reason
                       when not merged
     pairs             per pair a < b: accepted, transform (b's pixels onto a's, both as
-                      resampled to the merged map's resolution), confidence,
-                      status (tree, loop, dropped, weak: accepted below --min-lift, declined,
-                      unreached), residual of the final poses against the pair's answer
-                      (rotation_deg, translation_px)
+                      resampled to the merged map's resolution), confidence, status (tree,
+                      loop, dropped, weak: accepted below --min-lift, declined, unreached),
+                      residual of the final poses against the pair's answer (rotation_deg,
+                      translation_px)
     acceptance_index  agree / (agree + disagree) over every two maps known at the same cell
     overlap_cells, output, timings_ms
 
-The merged map has the first map's resolution, or --output-resolution's. Maps of another
+The merged map has the reference map's resolution, or --output-resolution's. Maps of another
 resolution are resampled to it (a note on stderr says so): a coarser cell takes the highest
 occupancy of the cells it covers, a finer one repeats its cell.
 
-A map that no such pair links to the first map is left out (a warning on stderr says so)
-and the others are merged. When no map links to the first, nothing is written.
+A map that no such pair links to the reference map is left out (a warning on stderr says
+so) and the others are merged. When no map links to the reference, nothing is written.
 
-Exit codes: 0 merged map written, 3 no map could be placed in the first map's frame (nothing
-written), 2 bad usage or bad input, 1 internal error.
+Exit codes: 0 merged map written, 3 no map could be placed in the reference map's frame
+(nothing written), 2 bad usage or bad input, 1 internal error.
 
 Examples:
   mapmerge merge fixtures/maps/sunil_pair_a/sunil_pair_a.yaml fixtures/maps/sunil_pair_b/sunil_pair_b.yaml -o merged.yaml
-  mapmerge merge robot1.yaml robot2.yaml robot3.yaml -o team.yaml --weights 1,1,0.5 --debug-png team.png";
+  mapmerge merge robot1.yaml robot2.yaml robot3.yaml -o team.yaml --weights 1,1,0.5 --debug-png team.png
+  mapmerge merge robot1.yaml robot2.yaml base.yaml -o team.yaml --reference base.yaml";
 
 /// Arguments of `mapmerge merge`.
 #[derive(Debug, Clone, Args)]
 #[command(after_help = AFTER)]
 pub struct MergeArgs {
     /// The maps (two or more: map_server YAMLs or bare .pgm/.png images). The first is the
-    /// reference: the merged map is in its frame (and at its resolution, unless
-    /// --output-resolution says otherwise)
+    /// reference unless --reference names another: the merged map is in its frame (and at its
+    /// resolution, unless --output-resolution says otherwise)
     #[arg(value_name = "MAP", num_args = 2.., required = true)]
     pub maps: Vec<PathBuf>,
     /// The merged map's YAML (.yaml or .yml); its PGM is written beside it with the same name
@@ -88,8 +90,12 @@ pub struct MergeArgs {
     /// spoils the merged map, one left out is reported; 0 uses every pair `estimate` accepts
     #[arg(long, value_name = "LIFT", default_value_t = 0.75, value_parser = super::probability)]
     pub min_lift: f64,
+    /// The map whose frame the merged map is in (and whose resolution it has, unless
+    /// --output-resolution says otherwise): one of the MAPs, as given [default: the first]
+    #[arg(long, value_name = "MAP")]
+    pub reference: Option<PathBuf>,
     /// Metres per cell of the merged map: every map of another resolution is resampled to it
-    /// [default: the first map's]
+    /// [default: the reference map's]
     #[arg(long, value_name = "M", value_parser = super::positive_finite)]
     pub output_resolution: Option<f64>,
     /// Print the report as one JSON object instead of text
@@ -184,13 +190,16 @@ pub fn run(args: &MergeArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode> {
         Some(w) => w.clone(),
         None => vec![1.0; args.maps.len()],
     };
-    let (maps, own) = load_all(&args.maps, bare, args.output_resolution)?;
-    let resolution = maps[0].grid.resolution();
+    let reference = reference_index(args)?;
+    let reference_path = &args.maps[reference];
+    let output_resolution = args.output_resolution;
+    let (maps, own) = load_all(&args.maps, bare, reference, output_resolution)?;
+    let resolution = maps[reference].grid.resolution();
     for (k, g) in own.iter().enumerate() {
         if !same_resolution(g.resolution, resolution) {
             let whose = match args.output_resolution {
                 Some(_) => "the --output-resolution".to_string(),
-                None => format!("the resolution of {}", args.maps[0].display()),
+                None => format!("the resolution of {}", reference_path.display()),
             };
             eprintln!(
                 "mapmerge: note: {}: resampled from {} to {resolution} m/cell, {whose}",
@@ -211,6 +220,7 @@ pub fn run(args: &MergeArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode> {
             ..FusionConfig::default()
         },
         min_edge_lift: args.min_lift,
+        reference,
         ..TeamConfig::default()
     };
     let grids: Vec<&OccupancyGrid> = maps.iter().map(|m| &m.grid).collect();
@@ -239,7 +249,7 @@ pub fn run(args: &MergeArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode> {
     let solution = &merged.poses;
 
     let mut report = json!({
-        "reference": args.maps[0].display().to_string(),
+        "reference": reference_path.display().to_string(),
         "rule": match args.rule {
             FusionRule::WeightedMean => "mean",
             FusionRule::OccupiedWins => "occupied-wins",
@@ -266,7 +276,7 @@ pub fn run(args: &MergeArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode> {
                 "reason": format!(
                     "no pair accepted at wall lift {} or more links it to {}",
                     args.min_lift,
-                    args.maps[0].display()
+                    reference_path.display()
                 ),
             })
         })
@@ -276,7 +286,7 @@ pub fn run(args: &MergeArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode> {
         report["output"] = Value::Null;
         report["reason"] = json!(format!(
             "no map could be placed in {}'s frame: every pair with it was declined",
-            args.maps[0].display()
+            reference_path.display()
         ));
         report["maps"] = json!(map_reports);
         report["timings_ms"] = json!({"total": start.elapsed().as_secs_f64() * 1e3});
@@ -341,12 +351,32 @@ pub fn run(args: &MergeArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// The index of `--reference` among the maps (0 without it): the map given by the same path,
+/// or by another path to the same file.
+fn reference_index(args: &MergeArgs) -> anyhow::Result<usize> {
+    let Some(reference) = &args.reference else {
+        return Ok(0);
+    };
+    let absolute = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
+    args.maps
+        .iter()
+        .position(|m| m == reference || absolute(m) == absolute(reference))
+        .ok_or_else(|| {
+            UsageError(format!(
+                "{}: --reference must be one of the maps given",
+                reference.display()
+            ))
+            .into()
+        })
+}
+
 /// Load every map and check each has known cells. A map of another resolution than `output`
-/// (by default the first map's) is resampled to it ([`OccupancyGrid::resample`]); the second
-/// value is each map's own geometry, as read.
+/// (by default that of map `reference`) is resampled to it ([`OccupancyGrid::resample`]); the
+/// second value is each map's own geometry, as read.
 fn load_all(
     paths: &[PathBuf],
     bare: &BareImageArgs,
+    reference: usize,
     output: Option<f64>,
 ) -> anyhow::Result<(Vec<LoadedMap>, Vec<GridGeometry>)> {
     let mut maps = paths
@@ -358,7 +388,7 @@ fn load_all(
         })
         .collect::<anyhow::Result<Vec<_>>>()?;
     let own: Vec<GridGeometry> = maps.iter().map(|m| m.grid.geometry()).collect();
-    let r0 = output.unwrap_or(own[0].resolution);
+    let r0 = output.unwrap_or(own[reference].resolution);
     for (m, p) in maps.iter_mut().zip(paths) {
         if !same_resolution(m.grid.resolution(), r0) {
             m.grid = m
@@ -494,7 +524,7 @@ fn human(w: &mut impl Write, r: &Value) -> std::io::Result<()> {
             o["report"].as_str().unwrap_or("?"),
         )?;
     }
-    for (k, m) in maps.iter().enumerate() {
+    for m in maps {
         let name = m["map"].as_str().unwrap_or("?");
         if m["merged"] != true {
             writeln!(
@@ -513,7 +543,11 @@ fn human(w: &mut impl Write, r: &Value) -> std::io::Result<()> {
         writeln!(
             w,
             "  {name}{}: frame at x {:.3} m, y {:.3} m, yaw {:.3} deg (pixels: theta {:.3} deg, tx {:.2}, ty {:.2}{scale}), weight {}",
-            if k == 0 { " (reference)" } else { "" },
+            if m["map"] == r["reference"] {
+                " (reference)"
+            } else {
+                ""
+            },
             f(&wd["x"]),
             f(&wd["y"]),
             f(&wd["yaw"]).to_degrees(),
