@@ -48,6 +48,10 @@ pub struct Args {
     /// error against the truth and what the pose graph made of it
     #[arg(long)]
     pub list: bool,
+    /// How each robot folds its beams into its map (see `cargo xtask gen --help`); row labels
+    /// name a mapper other than the default
+    #[arg(long, value_enum, default_value = "default")]
+    pub mapper: crate::r#gen::Mapper,
 }
 
 /// Overlap (of the smaller map) from which a pair counts as linking two maps in the truth.
@@ -123,7 +127,11 @@ pub fn run(args: Args) -> Result<()> {
     ];
     for (w, (kind_name, kind)) in worlds.into_iter().enumerate() {
         for &n in &args.robots {
-            let label = format!("{kind_name}, {n} robots");
+            let label = if args.mapper == crate::r#gen::Mapper::Default {
+                format!("{kind_name}, {n} robots")
+            } else {
+                format!("{kind_name}, {n} robots, {} mapper", args.mapper.name())
+            };
             rows.push((label, kind.clone(), n, 10 * w + n));
         }
     }
@@ -158,6 +166,7 @@ pub fn run(args: Args) -> Result<()> {
                 robots: vec![RobotConfig::default(); *n],
                 overlap: args.overlap,
                 overlap_tolerance: f64::INFINITY,
+                inverse_model: args.mapper.model(),
                 ..CaseConfig::default()
             };
             bar.inc(1);
