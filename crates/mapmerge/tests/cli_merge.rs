@@ -160,24 +160,43 @@ fn resampled_pixel(p: DVec2, own: f64, height: usize, to: f64, resampled_height:
     )
 }
 
-#[test]
-fn maps_of_other_resolutions_are_resampled_to_the_first_ones() {
-    let dir = TempDir::new().unwrap();
+/// The Intel lab's west 60 % and east 60 % (turned by 30 degrees), saved as `west.yaml` and
+/// `east.yaml` in `dir`: the two crops, each as (path, grid), the floor's resolution and the
+/// truth (the east crop's pixels onto the west crop's).
+struct WestEast {
+    west: (PathBuf, OccupancyGrid),
+    east: (PathBuf, OccupancyGrid),
+    resolution: f64,
+    truth: Rigid2,
+}
+
+fn west_east(dir: &TempDir) -> WestEast {
     let floor = load_map(fixture("intel_lab"), &LoadOptions::default()).unwrap();
     let w = floor.width();
     let to = [turned(&floor, 0.0), turned(&floor, 30.0)];
-    let (a, _) = crop(&dir, "west", &floor, |x, _| x < w * 6 / 10, to[0]);
-    let (_, gb) = crop(&dir, "east", &floor, |x, _| x >= w * 4 / 10, to[1]);
+    WestEast {
+        west: crop(dir, "west", &floor, |x, _| x < w * 6 / 10, to[0]),
+        east: crop(dir, "east", &floor, |x, _| x >= w * 4 / 10, to[1]),
+        resolution: floor.resolution(),
+        truth: to[0].compose(&to[1].inverse()),
+    }
+}
+
+#[test]
+fn maps_of_other_resolutions_are_resampled_to_the_first_ones() {
+    let dir = TempDir::new().unwrap();
+    let crops = west_east(&dir);
+    let (a, gb) = (&crops.west.0, &crops.east.1);
     // The east crop as a finer robot would map it (0.05 m/cell, each cell four), and as a
     // coarser one would (0.2 m/cell, the highest occupancy of each four cells). Measured:
     // 0.12 and 0.31 px off (in the merged map's cells), the frame 0.011 and 0.051 m.
-    let r = floor.resolution();
+    let r = crops.resolution;
     for (name, res, bound_px) in [("east_fine", r / 2.0, 0.5), ("east_coarse", r * 2.0, 1.5)] {
         let gk = gb.resample(res).unwrap();
         let path = dir.path().join(format!("{name}.yaml"));
         save_map(&gk, &path).unwrap();
         let out = dir.path().join(format!("{name}_team.yaml"));
-        let o = merge(&[s(&a), s(&path), "-o", s(&out), "--json"]);
+        let o = merge(&[s(a), s(&path), "-o", s(&out), "--json"]);
         let stderr = String::from_utf8_lossy(&o.stderr);
         assert_eq!(o.status.code(), Some(0), "{stderr}");
         assert_eq!(
@@ -204,7 +223,7 @@ fn maps_of_other_resolutions_are_resampled_to_the_first_ones() {
         // at 0.1 m/cell -> floor -> west crop -> merged map.
         let pose = transform(t);
         let reference = transform(&maps[0]["transform"]);
-        let truth = reference.compose(&to[0]).compose(&to[1].inverse());
+        let truth = reference.compose(&crops.truth);
         let (mut sum, mut n) = (0.0, 0usize);
         for y in (0..gk.height()).step_by(3) {
             for x in (0..gk.width()).step_by(3) {
@@ -238,7 +257,7 @@ fn maps_of_other_resolutions_are_resampled_to_the_first_ones() {
         );
         // The text report shows the scale too.
         let text_out = dir.path().join(format!("{name}_text.yaml"));
-        let o = merge(&[s(&a), s(&path), "-o", s(&text_out)]);
+        let o = merge(&[s(a), s(&path), "-o", s(&text_out)]);
         let text = String::from_utf8_lossy(&o.stdout);
         assert!(
             text.contains(&format!(", scale {scale}), weight")),
@@ -264,11 +283,8 @@ fn to_merged(entry: &serde_json::Value, p: DVec2) -> DVec2 {
 #[test]
 fn the_merged_map_can_have_another_resolution_than_the_first_one() {
     let dir = TempDir::new().unwrap();
-    let floor = load_map(fixture("intel_lab"), &LoadOptions::default()).unwrap();
-    let (w, r) = (floor.width(), floor.resolution());
-    let to = [turned(&floor, 0.0), turned(&floor, 30.0)];
-    let (a, ga) = crop(&dir, "west", &floor, |x, _| x < w * 6 / 10, to[0]);
-    let (_, gb) = crop(&dir, "east", &floor, |x, _| x >= w * 4 / 10, to[1]);
+    let crops = west_east(&dir);
+    let ((a, ga), gb, r) = (&crops.west, &crops.east.1, crops.resolution);
     // The east crop mapped at 0.05 m/cell; the merged map at that resolution, so the first
     // map is the one resampled.
     let fine = gb.resample(r / 2.0).unwrap();
@@ -276,7 +292,7 @@ fn the_merged_map_can_have_another_resolution_than_the_first_one() {
     save_map(&fine, &path).unwrap();
     let out = dir.path().join("fine_team.yaml");
     let o = merge(&[
-        s(&a),
+        s(a),
         s(&path),
         "-o",
         s(&out),
@@ -305,7 +321,7 @@ fn the_merged_map_can_have_another_resolution_than_the_first_one() {
     assert!((q - to_merged(&maps[0], p)).length() < 1e-6, "{q}");
     // The east map's known cells land where the truth puts them: its own pixel -> the crop at
     // 0.1 m/cell -> floor -> west crop -> merged map.
-    let truth = to[0].compose(&to[1].inverse());
+    let truth = crops.truth;
     let (mut sum, mut n) = (0.0, 0usize);
     for y in (0..fine.height()).step_by(3) {
         for x in (0..fine.width()).step_by(3) {
@@ -327,17 +343,14 @@ fn the_merged_map_can_have_another_resolution_than_the_first_one() {
 #[test]
 fn the_reference_can_be_any_of_the_maps() {
     let dir = TempDir::new().unwrap();
-    let floor = load_map(fixture("intel_lab"), &LoadOptions::default()).unwrap();
-    let w = floor.width();
-    let to = [turned(&floor, 0.0), turned(&floor, 30.0)];
-    let (a, ga) = crop(&dir, "west", &floor, |x, _| x < w * 6 / 10, to[0]);
-    let (b, _) = crop(&dir, "east", &floor, |x, _| x >= w * 4 / 10, to[1]);
+    let crops = west_east(&dir);
+    let ((a, ga), b) = (&crops.west, &crops.east.0);
     let out = dir.path().join("east_frame.yaml");
     // The east crop by another path to the same file.
     let east_too = format!("{}/./east.yaml", dir.path().display());
     let o = merge(&[
-        s(&a),
-        s(&b),
+        s(a),
+        s(b),
         "-o",
         s(&out),
         "--json",
@@ -351,7 +364,7 @@ fn the_reference_can_be_any_of_the_maps() {
         String::from_utf8_lossy(&o.stderr)
     );
     let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-    assert_eq!(report["reference"], s(&b));
+    assert_eq!(report["reference"], s(b));
     let maps = report["maps"].as_array().unwrap();
     // The east crop is only shifted, and its frame is the merged map's.
     let reference = transform(&maps[1]["transform"]);
@@ -360,26 +373,26 @@ fn the_reference_can_be_any_of_the_maps() {
         let v = maps[1]["world"][key].as_f64().unwrap();
         assert!(v.abs() < 1e-9, "{key} {v}");
     }
-    let truth = reference.compose(&to[1]).compose(&to[0].inverse());
+    let truth = reference.compose(&crops.truth.inverse());
     let pose = transform(&maps[0]["transform"]);
-    let disp = displacement_error(&ga, &pose, &truth).unwrap();
+    let disp = displacement_error(ga, &pose, &truth).unwrap();
     assert!(disp < 0.5, "west crop {disp} px off");
     // The text report marks it.
     let o = merge(&[
-        s(&a),
-        s(&b),
+        s(a),
+        s(b),
         "-o",
         s(&dir.path().join("text.yaml")),
         "--reference",
-        s(&b),
+        s(b),
     ]);
     let text = String::from_utf8_lossy(&o.stdout);
     assert!(
-        text.contains(&format!("  {} (reference): ", s(&b))),
+        text.contains(&format!("  {} (reference): ", s(b))),
         "{text}"
     );
     // A reference that is not one of the maps.
-    let o = merge(&[s(&a), s(&b), "-o", s(&out), "--reference", "nope.yaml"]);
+    let o = merge(&[s(a), s(b), "-o", s(&out), "--reference", "nope.yaml"]);
     assert_eq!(o.status.code(), Some(2));
     assert_eq!(
         String::from_utf8_lossy(&o.stderr).trim_end(),
