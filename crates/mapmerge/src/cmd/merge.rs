@@ -25,10 +25,10 @@ pairs, in parallel). The pairs accepted at wall lift --min-lift or more form a g
 spanning tree of the answers that rest on the most agreeing walls (large overlaps first)
 places every map it reaches in the reference map's frame (the first map, or --reference),
 and the answers that close loops refine those poses by least squares (an answer that
-disagrees with the tree by more than 3 degrees or 8 px is dropped as wrong). The placed maps are then fused: where one map alone
-is known it keeps its cell; where several are, the cell takes their occupancy probabilities'
-mean weighted by --weights (the paper's alpha * M1 + beta * M2, alpha + beta = 1), or with
---rule occupied-wins the wall any map saw.
+disagrees with the tree by more than 3 degrees or 8 px is dropped as wrong). The placed maps
+are then fused: where one map alone is known it keeps its cell; where several are, the cell
+takes their occupancy probabilities' mean weighted by --weights (the paper's alpha * M1 +
+beta * M2, alpha + beta = 1), or with --rule occupied-wins the wall any map saw.
 
 Output:
   OUT.yaml + OUT.pgm  the merged map, as map_saver writes it (0 occupied, 254 free, 205
@@ -192,8 +192,7 @@ pub fn run(args: &MergeArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode> {
     };
     let reference = reference_index(args)?;
     let reference_path = &args.maps[reference];
-    let output_resolution = args.output_resolution;
-    let (maps, own) = load_all(&args.maps, bare, reference, output_resolution)?;
+    let (maps, own) = load_all(&args.maps, bare, reference, args.output_resolution)?;
     let resolution = maps[reference].grid.resolution();
     for (k, g) in own.iter().enumerate() {
         if !same_resolution(g.resolution, resolution) {
