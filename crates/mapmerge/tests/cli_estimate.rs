@@ -10,9 +10,8 @@ use grid_core::metrics::{displacement_error, rotation_error_deg};
 use grid_core::{CellState, DVec2, OccupancyGrid, Rigid2};
 use tempfile::TempDir;
 
-fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../../fixtures/maps/{name}/{name}.yaml"))
-}
+mod common;
+use common::fixture;
 
 fn run(args: &[&Path]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_mapmerge"))
@@ -29,13 +28,9 @@ fn json(out: &Output) -> serde_json::Value {
     serde_json::from_str(&text).unwrap()
 }
 
+/// The `transform` of an `estimate --json` answer.
 fn transform(v: &serde_json::Value) -> Rigid2 {
-    let t = &v["transform"];
-    Rigid2::new(
-        t["theta"].as_f64().unwrap(),
-        t["tx"].as_f64().unwrap(),
-        t["ty"].as_f64().unwrap(),
-    )
+    common::transform(&v["transform"])
 }
 
 /// Write B = a rotated, shifted crop of `a` (B's centre lands on A's known centre plus `shift`)
@@ -127,17 +122,9 @@ fn same_seed_gives_the_same_answer() {
     assert_eq!(first["transform"], second["transform"]);
 }
 
+/// `mapmerge estimate args` refused ([`common::fails`]): its one stderr line.
 fn fails(args: &[&str]) -> String {
-    let out = Command::new(env!("CARGO_BIN_EXE_mapmerge"))
-        .arg("estimate")
-        .args(args)
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8(out.stderr).unwrap();
-    assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
-    assert!(out.stdout.is_empty());
-    assert_eq!(stderr.lines().count(), 1, "{stderr}");
-    stderr.trim_end().to_string()
+    common::fails(&[&["estimate"], args].concat())
 }
 
 #[test]

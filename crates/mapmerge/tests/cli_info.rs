@@ -5,22 +5,17 @@
 //! reasoning per map is in `crates/grid-core/tests/fixtures.rs`), not from the loader.
 
 use std::path::PathBuf;
-use std::process::{Command, Output};
 
 use serde_json::{Value, json};
+
+mod common;
+use common::mapmerge;
 
 fn fixture(name: &str, ext: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("../../fixtures/maps")
         .join(name)
         .join(format!("{name}.{ext}"))
-}
-
-fn mapmerge(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_mapmerge"))
-        .args(args)
-        .output()
-        .unwrap()
 }
 
 fn info_json(args: &[&str]) -> Value {

@@ -3,35 +3,23 @@
 //! nothing written but what a finished merge writes.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
 use grid_core::io::{LoadOptions, load_map, save_map};
 use grid_core::metrics::{agreement, displacement_error, rotation_error_deg};
 use grid_core::{CellState, DVec2, OccupancyGrid, Rigid2, UNKNOWN};
 use tempfile::TempDir;
 
-fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../../fixtures/maps/{name}/{name}.yaml"))
-}
+mod common;
+use common::{fixture, transform};
 
+/// Run `mapmerge merge args`.
 fn merge(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_mapmerge"))
-        .arg("merge")
-        .args(args)
-        .output()
-        .unwrap()
+    common::mapmerge(&[&["merge"], args].concat())
 }
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
-}
-
-fn transform(v: &serde_json::Value) -> Rigid2 {
-    Rigid2::new(
-        v["theta"].as_f64().unwrap(),
-        v["tx"].as_f64().unwrap(),
-        v["ty"].as_f64().unwrap(),
-    )
 }
 
 /// The cells of `floor` that `keep(x, y)` selects (the rest unknown), placed by `floor_to_map`
@@ -529,13 +517,9 @@ fn a_map_that_overlaps_no_other_is_left_out_or_nothing_is_written() {
     assert!(left.is_empty(), "{left:?}");
 }
 
+/// `mapmerge merge args` refused ([`common::fails`]): its one stderr line.
 fn fails(args: &[&str]) -> String {
-    let out = merge(args);
-    let stderr = String::from_utf8(out.stderr).unwrap();
-    assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
-    assert!(out.stdout.is_empty());
-    assert_eq!(stderr.lines().count(), 1, "{stderr}");
-    stderr.trim_end().to_string()
+    common::fails(&[&["merge"], args].concat())
 }
 
 #[test]
