@@ -1278,6 +1278,12 @@ fn register_as_given(
         (best.transform, best.verification) = (t.normalized(), v);
         angle_from_walls = true;
     }
+    // Both maps' shares of lone wall cells (the turn scan's gate and the clean-walls bar),
+    // scanned once, when first needed.
+    let lone = std::cell::OnceCell::new();
+    let lone_shares = || {
+        *lone.get_or_init(|| rayon::join(|| lone_wall_share(pa.grid), || lone_wall_share(pb.grid)))
+    };
     // The answer's angle scanned about its overlap (see `TurnScan`), unless it was polished or
     // stood out, as the ascent below, or took the Manhattan angle.
     if let Some(scan) = &config.turn_scan
@@ -1290,7 +1296,7 @@ fn register_as_given(
         let lever =
             wall_centres(&pa, &pb, &from).map_or(0.0, |(shared, all)| (shared - all).length());
         let alike = || {
-            let (sa, sb) = rayon::join(|| lone_wall_share(pa.grid), || lone_wall_share(pb.grid));
+            let (sa, sb) = lone_shares();
             sa.max(sb) <= scan.max_speckle_ratio * sa.min(sb)
         };
         let turns = if lever >= scan.min_lever_px && alike() {
@@ -1371,7 +1377,7 @@ fn register_as_given(
             return declined(reason, timings, candidates);
         }
         if let Some(clean) = &config.verify.clean_walls {
-            let (sa, sb) = rayon::join(|| lone_wall_share(pa.grid), || lone_wall_share(pb.grid));
+            let (sa, sb) = lone_shares();
             let bar = clean.bar(sa, sb);
             if v.mutual_contradiction > bar {
                 let reason = format!(
