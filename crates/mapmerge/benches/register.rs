@@ -30,7 +30,8 @@
 //! one refinement and scoring of a placement (`refine_and_score`: ICP with the range-bias
 //! offsets, then verification), one verification alone, the score ascent of an answer
 //! (`mapmerge::ascent`, which the hard pair's thin walls do not take) and its gate, the
-//! thickness of both maps' walls. The end-to-end time is about one sweep and the probes'
+//! thickness of both maps' walls, and both maps' shares of lone wall cells (the clean-walls
+//! bar's and the turn scan's measure). The end-to-end time is about one sweep and the probes'
 //! correlations plus a few dozen placements each searched, refined and scored (see
 //! `timings_ms` of `mapmerge estimate --json`). A pair where nothing passes pays for a second
 //! sweep, the other way round (`SweepConfig::reverse`): the declined pair.
@@ -40,7 +41,7 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use grid_core::io::{LoadOptions, load_map};
 use grid_core::{CorrespondenceSource, OccupancyGrid, Rigid2, UNKNOWN};
-use mapmerge::ascent::{ascend, wall_thickness};
+use mapmerge::ascent::{ascend, lone_wall_share, wall_thickness};
 use mapmerge::global::{sweep_placements, twins};
 use mapmerge::search::local_search;
 use mapmerge::verify::{PreparedMap, VerifyConfig, verify};
@@ -244,6 +245,11 @@ fn bench(c: &mut Criterion) {
     });
     g.bench_function("wall_thickness_both_maps", |bn| {
         bn.iter(|| (wall_thickness(&fa), wall_thickness(&fb)))
+    });
+    // The shares of lone wall cells that the clean-walls bar and the turn scan's gate read,
+    // side by side as `register` scans them.
+    g.bench_function("lone_wall_share_both_maps", |bn| {
+        bn.iter(|| rayon::join(|| lone_wall_share(&fa), || lone_wall_share(&fb)))
     });
     g.finish();
 }
