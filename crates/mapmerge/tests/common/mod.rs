@@ -1,0 +1,43 @@
+//! Helpers of the tests that run the `mapmerge` binary (`cli_*.rs`): each test file uses some
+//! of them.
+#![allow(dead_code)]
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+use grid_core::Rigid2;
+
+/// `fixtures/maps/NAME/NAME.yaml`.
+pub fn fixture(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join(format!("../../fixtures/maps/{name}/{name}.yaml"))
+}
+
+/// Run `mapmerge args`.
+pub fn mapmerge(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_mapmerge"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+/// Run `mapmerge args`, assert exit code 2, no stdout, no panic and one line on stderr, and
+/// return that line.
+pub fn fails(args: &[&str]) -> String {
+    let out = mapmerge(args);
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+    assert!(out.stdout.is_empty(), "{args:?}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert_eq!(stderr.lines().count(), 1, "one line: {stderr}");
+    stderr.trim_end().to_string()
+}
+
+/// The transform of a report's `{"theta", "tx", "ty"}` object.
+pub fn transform(v: &serde_json::Value) -> Rigid2 {
+    Rigid2::new(
+        v["theta"].as_f64().unwrap(),
+        v["tx"].as_f64().unwrap(),
+        v["ty"].as_f64().unwrap(),
+    )
+}
