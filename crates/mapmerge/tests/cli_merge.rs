@@ -496,18 +496,43 @@ fn a_map_that_overlaps_no_other_is_left_out_or_nothing_is_written() {
     assert!(report["maps"][2]["transform"].is_null());
     assert!(out.exists() && out.with_extension("pgm").exists());
 
-    // The first map overlaps none: exit 3, and nothing is written.
+    // The first map overlaps none: exit 3, and nothing is written. The two that link to each
+    // other are named, with the flag that merges them.
     let out = dir.path().join("none.yaml");
-    let o = merge(&[s(&c), s(&a), "-o", s(&out), "--json"]);
+    let o = merge(&[s(&c), s(&a), s(&b), "-o", s(&out), "--json"]);
     assert_eq!(o.status.code(), Some(3));
     let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert!(report["output"].is_null());
-    assert!(
-        report["reason"]
-            .as_str()
-            .unwrap()
-            .contains("no map could be placed"),
-        "{report}"
+    let linked = format!(
+        "{} and {} link to each other: --reference {} merges them",
+        a.display(),
+        b.display(),
+        a.display()
+    );
+    assert_eq!(
+        report["reason"],
+        format!(
+            "no map could be placed in {}'s frame: every pair with it was declined; {linked}",
+            c.display()
+        )
+    );
+    let reasons: Vec<&str> = report["maps"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| m["reason"].as_str().unwrap())
+        .collect();
+    let unlinked = format!(
+        "no pair accepted at wall lift 0.75 or more links it to {}; {linked}",
+        c.display()
+    );
+    assert_eq!(
+        reasons,
+        [
+            "the reference map: no other map could be placed in its frame",
+            &unlinked,
+            &unlinked
+        ]
     );
     let left: Vec<_> = std::fs::read_dir(dir.path())
         .unwrap()

@@ -54,7 +54,8 @@ resolution are resampled to it (a note on stderr says so): a coarser cell takes 
 occupancy of the cells it covers, a finer one repeats its cell.
 
 A map that no such pair links to the reference map is left out (a warning on stderr says
-so) and the others are merged. When no map links to the reference, nothing is written.
+so, naming the maps it does link to, if any: --reference one of them merges those) and the
+others are merged. When no map links to the reference, nothing is written.
 
 Exit codes: 0 merged map written, 3 no map could be placed in the reference map's frame
 (nothing written), 2 bad usage or bad input, 1 internal error.
@@ -259,12 +260,38 @@ pub fn run(args: &MergeArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode> {
             pair_report(&args.maps, p, p.edge.map(|e| (solution.status[e], solution.residuals[e])), args.min_lift)
         }).collect::<Vec<_>>(),
     });
+    // Maps that the pairs link to each other but not to the reference: the user can merge
+    // them by naming one of them the reference.
+    let groups = linked_groups(args.maps.len(), &merged.pairs, &solution.status);
+    let elsewhere = |k: usize| -> Option<String> {
+        let group = &groups[k];
+        (group.len() > 1 && !group.contains(&reference)).then(|| {
+            format!(
+                "{} link to each other: --reference {} merges them",
+                names(&args.maps, group),
+                args.maps[group[0]].display()
+            )
+        })
+    };
     let mut map_reports: Vec<Value> = args
         .maps
         .iter()
         .zip(&weights)
         .zip(&own)
-        .map(|((path, w), g)| {
+        .enumerate()
+        .map(|(k, ((path, w), g))| {
+            let mut reason = if k == reference {
+                "the reference map: no other map could be placed in its frame".to_string()
+            } else {
+                format!(
+                    "no pair accepted at wall lift {} or more links it to {}",
+                    args.min_lift,
+                    reference_path.display()
+                )
+            };
+            if let Some(hint) = elsewhere(k) {
+                reason.push_str(&format!("; {hint}"));
+            }
             json!({
                 "map": path.display().to_string(),
                 "merged": false,
@@ -272,21 +299,38 @@ pub fn run(args: &MergeArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode> {
                 "resolution": g.resolution,
                 "transform": null,
                 "world": null,
-                "reason": format!(
-                    "no pair accepted at wall lift {} or more links it to {}",
-                    args.min_lift,
-                    reference_path.display()
-                ),
+                "reason": reason,
             })
         })
         .collect();
 
     let Some(fused) = &merged.fused else {
         report["output"] = Value::Null;
-        report["reason"] = json!(format!(
-            "no map could be placed in {}'s frame: every pair with it was declined",
-            reference_path.display()
-        ));
+        let weak = merged
+            .pairs
+            .iter()
+            .any(|p| (p.a == reference || p.b == reference) && p.registration.accepted.is_some());
+        let mut reason = format!(
+            "no map could be placed in {}'s frame: {}",
+            reference_path.display(),
+            if weak {
+                format!(
+                    "no pair with it was accepted at wall lift {} or more",
+                    args.min_lift
+                )
+            } else {
+                "every pair with it was declined".to_string()
+            }
+        );
+        // The largest group of maps linked to each other, the earliest first on a tie.
+        if let Some(hint) = (0..args.maps.len())
+            .filter(|&k| groups[k][0] == k)
+            .max_by_key(|&k| (groups[k].len(), std::cmp::Reverse(k)))
+            .and_then(elsewhere)
+        {
+            reason.push_str(&format!("; {hint}"));
+        }
+        report["reason"] = json!(reason);
         report["maps"] = json!(map_reports);
         report["timings_ms"] = json!({"total": start.elapsed().as_secs_f64() * 1e3});
         print_report(args, &report)?;
@@ -348,6 +392,42 @@ pub fn run(args: &MergeArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode> {
     }
     print_report(args, &report)?;
     Ok(ExitCode::SUCCESS)
+}
+
+/// Per map, the maps that the pose graph's usable edges (every accepted pair at `--min-lift`
+/// or more but those dropped as wrong) link it to, itself included, in index order.
+fn linked_groups(n: usize, pairs: &[TeamPair], status: &[EdgeStatus]) -> Vec<Vec<usize>> {
+    // Union-find, each group's root its smallest map.
+    let mut root: Vec<usize> = (0..n).collect();
+    fn find(root: &mut [usize], mut k: usize) -> usize {
+        while root[k] != k {
+            root[k] = root[root[k]];
+            k = root[k];
+        }
+        k
+    }
+    for p in pairs {
+        if p.edge.is_some_and(|e| status[e] != EdgeStatus::Dropped) {
+            let (ra, rb) = (find(&mut root, p.a), find(&mut root, p.b));
+            root[ra.max(rb)] = ra.min(rb);
+        }
+    }
+    let roots: Vec<usize> = (0..n).map(|k| find(&mut root, k)).collect();
+    (0..n)
+        .map(|k| (0..n).filter(|&j| roots[j] == roots[k]).collect())
+        .collect()
+}
+
+/// The maps `group` as a list in words: `a`, `a and b`, `a, b and c`.
+fn names(paths: &[PathBuf], group: &[usize]) -> String {
+    let all: Vec<String> = group
+        .iter()
+        .map(|&k| paths[k].display().to_string())
+        .collect();
+    match all.split_last() {
+        Some((last, rest)) if !rest.is_empty() => format!("{} and {last}", rest.join(", ")),
+        _ => all.join(""),
+    }
 }
 
 /// The index of `--reference` among the maps (0 without it): the map given by the same path,
