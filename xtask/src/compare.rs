@@ -81,10 +81,26 @@ pub struct Case {
     pub success: bool,
     pub displacement_error_px: Option<f64>,
     pub error: Option<String>,
+    /// The best candidate (the answer, when accepted); `None` in lines that lack it.
+    #[serde(default)]
+    pub best: Option<Best>,
+}
+
+/// The best candidate of a case, as far as `cargo xtask calibrate` reads it.
+#[derive(Debug, Clone, PartialEq, serde::Deserialize)]
+pub struct Best {
+    pub verification: BestVerification,
+}
+
+/// The scores of the best candidate that `cargo xtask calibrate` reads.
+#[derive(Debug, Clone, PartialEq, serde::Deserialize)]
+pub struct BestVerification {
+    /// Its wall lift: the `confidence` of `mapmerge estimate` (clamped to [0, 1] there).
+    pub wall_lift: f64,
 }
 
 impl Case {
-    fn outcome(&self) -> Outcome {
+    pub fn outcome(&self) -> Outcome {
         match (&self.error, self.accepted, self.success) {
             (Some(_), _, _) => Outcome::Failed,
             (None, true, true) => Outcome::Registered,
@@ -93,7 +109,7 @@ impl Case {
         }
     }
 
-    fn key(&self) -> (String, String, String, u64) {
+    pub fn key(&self) -> (String, String, String, u64) {
         (
             self.suite.clone(),
             self.row.clone(),
@@ -296,6 +312,7 @@ mod tests {
             success,
             displacement_error_px: d,
             error: None,
+            best: None,
         }
     }
 

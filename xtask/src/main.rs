@@ -3,6 +3,7 @@
 
 use clap::{Parser, Subcommand};
 
+mod calibrate;
 mod compare;
 mod eval;
 mod r#gen;
@@ -31,6 +32,8 @@ enum Command {
     Regress(regress::Args),
     /// Measure how well `mapmerge merge` places every map of simulated robot teams.
     Team(team::Args),
+    /// Tabulate accepted answers' errors by their confidence, over runs of `eval --out`.
+    Calibrate(calibrate::Args),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -40,5 +43,6 @@ fn main() -> anyhow::Result<()> {
         Command::Compare(args) => compare::run(args),
         Command::Regress(args) => regress::run(args),
         Command::Team(args) => team::run(args),
+        Command::Calibrate(args) => calibrate::run(args),
     }
 }
