@@ -460,6 +460,23 @@ fn a_map_that_shares_nothing_with_the_first_is_placed_through_another() {
     let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(statuses(&report), ["weak", "declined", "weak"], "{report}");
     assert!(!out.exists() && !out.with_extension("json").exists());
+    // The middle crop's reason names its weak pair with the first and the bar that uses it;
+    // the east crop's weak pair is with the middle one, which is not placed: no such hint.
+    let lift = report["pairs"][0]["confidence"].as_f64().unwrap();
+    let unlinked = format!(
+        "no pair accepted at wall lift 1 or more links it to {}",
+        a.display()
+    );
+    assert_eq!(
+        report["maps"][1]["reason"],
+        format!(
+            "{unlinked}; its pair with {} was accepted at wall lift {lift:.3}, below --min-lift \
+             1: --min-lift {} uses it",
+            a.display(),
+            (lift * 100.0).floor() / 100.0
+        )
+    );
+    assert_eq!(report["maps"][2]["reason"], unlinked);
 }
 
 #[test]

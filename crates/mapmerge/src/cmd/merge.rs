@@ -54,8 +54,9 @@ resolution are resampled to it (a note on stderr says so): a coarser cell takes 
 occupancy of the cells it covers, a finer one repeats its cell.
 
 A map that no such pair links to the reference map is left out (a warning on stderr says
-so, naming the maps it does link to, if any: --reference one of them merges those) and the
-others are merged. When no map links to the reference, nothing is written.
+so, naming its pair accepted below --min-lift with a placed map and the --min-lift that uses
+it, or the maps it does link to and the --reference that merges those) and the others are
+merged. When no map links to the reference, nothing is written.
 
 Exit codes: 0 merged map written, 3 no map could be placed in the reference map's frame
 (nothing written), 2 bad usage or bad input, 1 internal error.
@@ -273,6 +274,33 @@ pub fn run(args: &MergeArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode> {
             )
         })
     };
+    // A pair accepted below --min-lift that would link a map to the reference's maps.
+    let weak_way_in = |k: usize| -> Option<String> {
+        let placed = &groups[reference];
+        merged
+            .pairs
+            .iter()
+            .filter(|p| p.edge.is_none())
+            .filter_map(|p| {
+                let other = match (p.a == k, p.b == k) {
+                    (true, _) => p.b,
+                    (_, true) => p.a,
+                    _ => return None,
+                };
+                let lift = p.registration.accepted.as_ref()?.verification.wall_lift;
+                placed.contains(&other).then_some((other, lift))
+            })
+            .max_by(|x, y| x.1.total_cmp(&y.1))
+            .map(|(other, lift)| {
+                format!(
+                    "its pair with {} was accepted at wall lift {lift:.3}, below --min-lift {}: \
+                     --min-lift {} uses it",
+                    args.maps[other].display(),
+                    args.min_lift,
+                    (lift * 100.0).floor() / 100.0
+                )
+            })
+    };
     let mut map_reports: Vec<Value> = args
         .maps
         .iter()
@@ -289,7 +317,7 @@ pub fn run(args: &MergeArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode> {
                     reference_path.display()
                 )
             };
-            if let Some(hint) = elsewhere(k) {
+            for hint in [weak_way_in(k), elsewhere(k)].into_iter().flatten() {
                 reason.push_str(&format!("; {hint}"));
             }
             json!({
