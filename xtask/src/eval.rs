@@ -94,6 +94,11 @@ pub struct EvalArgs {
     /// changes.
     #[arg(long, value_name = "BASE,PER_LONE_SHARE|off", value_parser = clean_walls_values)]
     clean_walls: Option<CleanWallsArg>,
+    /// Override the smaller overlap allowed where the walls fit crisply
+    /// (`mapmerge::verify::CrispSliver`) as `OVERLAP,LIFT` (`off` holds every placement to the
+    /// minimum overlap; default: the library's), to measure what it changes.
+    #[arg(long, value_name = "OVERLAP,LIFT|off", value_parser = crisp_sliver_values)]
+    crisp_sliver: Option<CrispSliverArg>,
     /// Override the wall lift from which an answer's walls count as crisp and are held to the
     /// misfit bar (`mapmerge::VerifyConfig::crisp_wall_lift`; above `1` turns the rule off;
     /// default: the library's), to measure what it changes.
@@ -458,6 +463,29 @@ fn clean_walls_values(s: &str) -> Result<CleanWallsArg, String> {
     }
 }
 
+/// The value of `--crisp-sliver`: the exception, or `None` for `off`.
+#[derive(Debug, Clone, Copy)]
+struct CrispSliverArg(Option<mapmerge::verify::CrispSliver>);
+
+/// `--crisp-sliver OVERLAP,LIFT` (two numbers in [0, 1]) or `off`.
+fn crisp_sliver_values(s: &str) -> Result<CrispSliverArg, String> {
+    if s == "off" {
+        return Ok(CrispSliverArg(None));
+    }
+    let v: Vec<f64> = numbers(s)?;
+    match v.as_slice() {
+        &[min_overlap_fraction, min_wall_lift] if v.iter().all(|g| (0.0..=1.0).contains(g)) => {
+            Ok(CrispSliverArg(Some(mapmerge::verify::CrispSliver {
+                min_overlap_fraction,
+                min_wall_lift,
+            })))
+        }
+        _ => Err(format!(
+            "expected an overlap fraction and a wall lift in [0, 1] (OVERLAP,LIFT) or `off`, got {s:?}"
+        )),
+    }
+}
+
 /// `--stand-out LIFT,MARGIN`: two numbers in [0, 1].
 fn stand_out_values(s: &str) -> Result<(f64, f64), String> {
     let v: Vec<f64> = numbers(s)?;
@@ -808,6 +836,9 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
     }
     if let Some(CleanWallsArg(c)) = args.clean_walls {
         config.pair.verify.clean_walls = c;
+    }
+    if let Some(CrispSliverArg(c)) = args.crisp_sliver {
+        config.pair.verify.crisp_sliver = c;
     }
     if let Some(c) = args.max_wall_contradiction {
         config.pair.verify.max_wall_contradiction = c;
