@@ -22,10 +22,9 @@ Sets (20 cases per row, as in docs/EVALUATION.md):
   floors  five real floors at 30 % overlap, seeds 7, 8
   floorzero  the same floors at zero overlap (must decline), seed 7
   crops   the same floors cut in two, sharing 30 % or nothing (must decline), seed 7
-All of them but floors took 19 minutes on a 2-core Intel Xeon VM (2026-12-05); floors
-took 4 minutes a seed there. In a faster hour of that VM the whole batch, floors included,
-took 20 minutes (2026-12-05, 18:42-19:02 UTC); floorzero took 1 minute (22:14 UTC), crops
-3 minutes (23:31 UTC, beside another eval).
+The whole batch (2,100 cases) took 18 minutes on a 2-core Intel Xeon VM (2026-12-06,
+02:09-02:27 UTC). `cargo xtask calibrate DIR` then tabulates its answers' errors by
+confidence.
 
 Examples:
   cargo xtask regress --out /tmp/before
