@@ -114,6 +114,47 @@ fn unrelated_maps_are_declined_with_exit_3() {
 }
 
 #[test]
+fn a_pair_that_shares_less_than_min_overlap_is_declined() {
+    // The real pair shares 38.9 % of the smaller map's known cells.
+    let (a, b) = (fixture("sunil_pair_a"), fixture("sunil_pair_b"));
+    let estimate = |min: &str| {
+        Command::new(env!("CARGO_BIN_EXE_mapmerge"))
+            .arg("estimate")
+            .args([&a, &b])
+            .args(["--json", "--min-overlap", min])
+            .output()
+            .unwrap()
+    };
+    let out = estimate("0.35");
+    assert_eq!(out.status.code(), Some(0));
+    let out = estimate("0.45");
+    let v = json(&out);
+    assert_eq!(out.status.code(), Some(3), "{v}");
+    // The reason names the best placement's overlap, under the bar.
+    let reason = v["reason"].as_str().unwrap();
+    let overlap: f64 = reason
+        .split("overlap ")
+        .nth(1)
+        .and_then(|r| r.split('%').next())
+        .and_then(|p| p.parse().ok())
+        .unwrap_or_else(|| panic!("{reason}"));
+    assert!((38.0..45.0).contains(&overlap), "{reason}");
+    for bad in ["NaN", "1.5", "-0.1"] {
+        assert_eq!(
+            fails(&[s(&a), s(&b), &format!("--min-overlap={bad}")]),
+            format!(
+                "mapmerge: error: invalid value '{bad}' for '--min-overlap <FRACTION>': must be \
+                 a number between 0 and 1 (see 'mapmerge --help')"
+            )
+        );
+    }
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+#[test]
 fn same_seed_gives_the_same_answer() {
     let a = fixture("sunil_pair_a");
     let b = fixture("sunil_pair_b");

@@ -135,6 +135,12 @@ pub struct RegistrationArgs {
     /// Seed of RANSAC; the same seed gives the same answer
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
+    /// Share of the smaller map's known cells that a placement must find known in both maps
+    /// [default: 0.15, or 0.1 for a placement whose walls fit at wall lift 0.95 or more].
+    /// Given, every placement needs it: lower it for maps that share only a corner, at the
+    /// risk of accepting a sliver where a few walls happen to line up
+    #[arg(long, value_name = "FRACTION", value_parser = probability)]
+    pub min_overlap: Option<f64>,
 }
 
 impl RegistrationArgs {
@@ -145,6 +151,10 @@ impl RegistrationArgs {
             ..RegisterConfig::default()
         };
         config.pair.ransac.seed = self.seed;
+        if let Some(f) = self.min_overlap {
+            config.pair.verify.min_overlap_fraction = f;
+            config.pair.verify.crisp_sliver = None;
+        }
         config
     }
 }
