@@ -440,27 +440,36 @@ fn noise_value(s: &str) -> Result<f64, String> {
     }
 }
 
+/// `A,B` (two numbers that each pass `valid`) or `off` (`None`); `Err(expected)` otherwise,
+/// with what was given.
+fn pair_or_off(
+    s: &str,
+    valid: impl Fn(f64) -> bool,
+    expected: &str,
+) -> Result<Option<(f64, f64)>, String> {
+    if s == "off" {
+        return Ok(None);
+    }
+    match numbers::<f64>(s)?.as_slice() {
+        &[a, b] if valid(a) && valid(b) => Ok(Some((a, b))),
+        _ => Err(format!("expected {expected} or `off`, got {s:?}")),
+    }
+}
+
 /// The value of `--clean-walls`: the bar, or `None` for `off`.
 #[derive(Debug, Clone, Copy)]
 struct CleanWallsArg(Option<mapmerge::verify::CleanWalls>);
 
 /// `--clean-walls BASE,PER_LONE_SHARE` or `off`.
 fn clean_walls_values(s: &str) -> Result<CleanWallsArg, String> {
-    if s == "off" {
-        return Ok(CleanWallsArg(None));
-    }
-    let v: Vec<f64> = numbers(s)?;
-    match v.as_slice() {
-        &[base, per_lone_share] if v.iter().all(|g| g.is_finite() && *g >= 0.0) => {
-            Ok(CleanWallsArg(Some(mapmerge::verify::CleanWalls {
-                base,
-                per_lone_share,
-            })))
+    let valid = |g: f64| g.is_finite() && g >= 0.0;
+    let pair = pair_or_off(s, valid, "two numbers >= 0 (BASE,PER_LONE_SHARE)")?;
+    Ok(CleanWallsArg(pair.map(|(base, per_lone_share)| {
+        mapmerge::verify::CleanWalls {
+            base,
+            per_lone_share,
         }
-        _ => Err(format!(
-            "expected two numbers >= 0 (BASE,PER_LONE_SHARE) or `off`, got {s:?}"
-        )),
-    }
+    })))
 }
 
 /// The value of `--crisp-sliver`: the exception, or `None` for `off`.
@@ -469,21 +478,15 @@ struct CrispSliverArg(Option<mapmerge::verify::CrispSliver>);
 
 /// `--crisp-sliver OVERLAP,LIFT` (two numbers in [0, 1]) or `off`.
 fn crisp_sliver_values(s: &str) -> Result<CrispSliverArg, String> {
-    if s == "off" {
-        return Ok(CrispSliverArg(None));
-    }
-    let v: Vec<f64> = numbers(s)?;
-    match v.as_slice() {
-        &[min_overlap_fraction, min_wall_lift] if v.iter().all(|g| (0.0..=1.0).contains(g)) => {
-            Ok(CrispSliverArg(Some(mapmerge::verify::CrispSliver {
-                min_overlap_fraction,
-                min_wall_lift,
-            })))
-        }
-        _ => Err(format!(
-            "expected an overlap fraction and a wall lift in [0, 1] (OVERLAP,LIFT) or `off`, got {s:?}"
-        )),
-    }
+    let valid = |g: f64| (0.0..=1.0).contains(&g);
+    let expected = "an overlap fraction and a wall lift in [0, 1] (OVERLAP,LIFT)";
+    let pair = pair_or_off(s, valid, expected)?;
+    Ok(CrispSliverArg(pair.map(
+        |(min_overlap_fraction, min_wall_lift)| mapmerge::verify::CrispSliver {
+            min_overlap_fraction,
+            min_wall_lift,
+        },
+    )))
 }
 
 /// `--stand-out LIFT,MARGIN`: two numbers in [0, 1].
@@ -1479,7 +1482,10 @@ pub fn run(args: EvalArgs) -> Result<()> {
 
 #[cfg(test)]
 mod tests {
-    use super::{Row, Source, angle_window, export, grey_values, slug, stand_out_values};
+    use super::{
+        Row, Source, angle_window, clean_walls_values, crisp_sliver_values, export, grey_values,
+        slug, stand_out_values,
+    };
     use grid_core::io::{LoadOptions, load_map};
     use mapsim::{CaseConfig, generate_case};
 
@@ -1616,6 +1622,34 @@ mod tests {
         assert_eq!(stand_out_values("0.7"), Err(want.to_string()));
         assert!(stand_out_values("0.7,NaN").is_err());
         assert!(stand_out_values("0.7,1.5").is_err());
+    }
+
+    #[test]
+    fn rule_overrides_take_two_numbers_or_off() {
+        let sliver = |s| crisp_sliver_values(s).map(|a| a.0);
+        assert_eq!(sliver("off"), Ok(None));
+        assert_eq!(
+            sliver("0.1, 0.95"),
+            Ok(Some(mapmerge::verify::CrispSliver {
+                min_overlap_fraction: 0.1,
+                min_wall_lift: 0.95
+            }))
+        );
+        let want = "expected an overlap fraction and a wall lift in [0, 1] (OVERLAP,LIFT) or \
+                    `off`, got \"0.1,1.5\"";
+        assert_eq!(sliver("0.1,1.5"), Err(want.to_string()));
+        let walls = |s| clean_walls_values(s).map(|a| a.0);
+        assert_eq!(walls("off"), Ok(None));
+        assert_eq!(
+            walls("0.02,4"),
+            Ok(Some(mapmerge::verify::CleanWalls {
+                base: 0.02,
+                per_lone_share: 4.0
+            }))
+        );
+        assert!(walls("0.02,-1").is_err());
+        assert!(walls("0.02").is_err());
+        assert!(walls("0.02,NaN").is_err());
     }
 
     #[test]

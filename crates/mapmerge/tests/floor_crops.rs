@@ -10,16 +10,21 @@ use grid_core::metrics::{displacement_error, rotation_error_deg};
 use grid_core::{OccupancyGrid, Rigid2, UNKNOWN};
 use mapmerge::{RegisterConfig, register};
 
+/// Fixture floor `name` (`fixtures/maps/NAME/NAME.yaml`).
+fn floor(name: &str) -> OccupancyGrid {
+    let path = format!(
+        "{}/../../fixtures/maps/{name}/{name}.yaml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    load_map(&path, &LoadOptions::default()).expect("fixture loads")
+}
+
 /// The western and the eastern three quarters of fixture floor `name` (half its width shared),
 /// the eastern turned by `degrees` with only about `keep_percent` % of its wall cells kept (the
 /// others unknown, picked by a fixed hash of the cell), each on a canvas that holds any turn of
 /// the floor. Returns A, B and the truth (B onto A).
 fn crops(name: &str, degrees: f64, keep_percent: u64) -> (OccupancyGrid, OccupancyGrid, Rigid2) {
-    let path = format!(
-        "{}/../../fixtures/maps/{name}/{name}.yaml",
-        env!("CARGO_MANIFEST_DIR")
-    );
-    let floor = load_map(&path, &LoadOptions::default()).expect("fixture loads");
+    let floor = floor(name);
     let (w, h) = (floor.width(), floor.height());
     let cut = w * 3 / 4;
     let crop = |keep: std::ops::Range<usize>| {
@@ -76,11 +81,7 @@ fn crops_of_the_wpi_ilab_floor_with_sparse_walls_are_registered() {
 /// where without it the pair was answered 90 degrees off.
 #[test]
 fn a_floor_cut_in_two_with_nothing_shared_is_declined_for_walls_in_free_space() {
-    let path = format!(
-        "{}/../../fixtures/maps/intel_lab/intel_lab.yaml",
-        env!("CARGO_MANIFEST_DIR")
-    );
-    let floor = load_map(&path, &LoadOptions::default()).expect("fixture loads");
+    let floor = floor("intel_lab");
     let config = mapsim::CropConfig {
         overlap: 0.0,
         ..Default::default()
@@ -108,11 +109,7 @@ fn a_floor_cut_in_two_with_nothing_shared_is_declined_for_walls_in_free_space() 
 /// needs otherwise, the pair was declined.
 #[test]
 fn floor_parts_that_share_a_tenth_of_their_known_cells_are_registered_when_their_walls_agree() {
-    let path = format!(
-        "{}/../../fixtures/maps/uos_avz/uos_avz.yaml",
-        env!("CARGO_MANIFEST_DIR")
-    );
-    let floor = load_map(&path, &LoadOptions::default()).expect("fixture loads");
+    let floor = floor("uos_avz");
     let pair = mapsim::crop_pair(&floor, &mapsim::CropConfig::default(), 8_004_000).unwrap();
     let r = register(&pair.a, &pair.b, &RegisterConfig::default()).unwrap();
     let c = r
