@@ -339,6 +339,12 @@ pub struct EvalArgs {
     /// (robot rows only; the labels say so), to measure a change on maps of other noise.
     #[arg(long, value_parser = noise_value)]
     noise: Option<f64>,
+    /// Bend the second part of every `crops` pair by this angle at each end, in degrees
+    /// (`mapsim::CropConfig::bend_deg`: a map built with a drifting heading), against the
+    /// unbent truth; the labels say so. The displacement error then includes the bend itself,
+    /// so read the accepted rate and the declines' reasons.
+    #[arg(long, value_name = "DEG", value_parser = angle_window)]
+    bend: Option<f64>,
     /// Only the rows whose label contains this text (e.g. `"overlap 0.3"`).
     #[arg(long)]
     only: Option<String>,
@@ -1347,6 +1353,14 @@ pub fn run(args: EvalArgs) -> Result<()> {
                     robot.noise_bound = noise;
                 }
                 row.label = format!("{}, every noise set to {:.0}%", row.label, noise * 100.0);
+            }
+        }
+    }
+    if let Some(bend) = args.bend {
+        for row in &mut rows {
+            if let Source::Crops(_, config) = &mut row.source {
+                config.bend_deg = bend;
+                row.label = format!("{}, second part bent {bend} deg", row.label);
             }
         }
     }

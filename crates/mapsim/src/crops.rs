@@ -26,6 +26,12 @@ pub struct CropConfig {
     pub cut: (f64, f64),
     /// Unknown cells around each part's known cells. Default 10.
     pub margin: usize,
+    /// Bend the second part before it is turned, as a map built with a drifting heading is
+    /// bent: each of its cells turns about the part's middle by this angle (degrees) times
+    /// its signed distance from the middle across the cut over the part's half extent there,
+    /// so the part's two ends turn by `-bend_deg` and `+bend_deg`. The truth stays the
+    /// unbent one, which the middle of the part keeps. Default 0.
+    pub bend_deg: f64,
 }
 
 impl Default for CropConfig {
@@ -34,6 +40,7 @@ impl Default for CropConfig {
             overlap: 0.3,
             cut: (0.35, 0.65),
             margin: 10,
+            bend_deg: 0.0,
         }
     }
 }
@@ -64,10 +71,11 @@ pub struct CropPair {
 pub fn crop_pair(map: &OccupancyGrid, config: &CropConfig, seed: u64) -> Result<CropPair> {
     let (lo, hi) = config.cut;
     let valid = (0.0..1.0).contains(&config.overlap) && 0.0 < lo && lo <= hi && hi < 1.0;
-    if !valid {
+    if !valid || !config.bend_deg.is_finite() {
         return Err(Error::Config(format!(
-            "crop overlap {} must lie in [0, 1) and the cut range {:?} within (0, 1)",
-            config.overlap, config.cut
+            "crop overlap {} must lie in [0, 1), the cut range {:?} within (0, 1) and the bend \
+             {} be finite",
+            config.overlap, config.cut, config.bend_deg
         )));
     }
     let Some((x0, y0, w, h)) = map.known_bounds(0) else {
@@ -131,7 +139,28 @@ pub fn crop_pair(map: &OccupancyGrid, config: &CropConfig, seed: u64) -> Result<
     let middle = DVec2::new(x0 as f64 + w as f64 / 2.0, y0 as f64 + h as f64 / 2.0);
     let half = (side / 2) as f64;
     let map_to_b = Rigid2::new(angle, half, half).compose(&Rigid2::new(0.0, -middle.x, -middle.y));
-    let b = part(&in_b)
+    let mut b = part(&in_b);
+    if config.bend_deg != 0.0 {
+        // The part's extent across the cut, in the map's cells.
+        let (start, end) = (cut - band / 2.0, 1.0);
+        let from = |f: f64| f * extent + if vertical_cut { x0 } else { y0 } as f64;
+        let (lo_px, hi_px) = (from(start), from(end));
+        let mid_across = (lo_px + hi_px) / 2.0;
+        let half_across = ((hi_px - lo_px) / 2.0).max(1.0);
+        let pivot = if vertical_cut {
+            DVec2::new(mid_across, middle.y)
+        } else {
+            DVec2::new(middle.x, mid_across)
+        };
+        b = bent(
+            &b,
+            pivot,
+            vertical_cut,
+            half_across,
+            config.bend_deg.to_radians(),
+        );
+    }
+    let b = b
         .warp(&map_to_b, side, side)
         .map_err(|e| Error::Config(e.to_string()))?;
     Ok(CropPair {
@@ -142,6 +171,37 @@ pub fn crop_pair(map: &OccupancyGrid, config: &CropConfig, seed: u64) -> Result<
         vertical_cut,
         angle,
     })
+}
+
+/// `map` bent about `pivot`: the cell at signed distance `u` from the pivot across the cut
+/// (along x when `vertical_cut`, else along y) turned by `max_angle * u / half`, nearest
+/// neighbour, cells from outside the map unknown.
+fn bent(
+    map: &OccupancyGrid,
+    pivot: DVec2,
+    vertical_cut: bool,
+    half: f64,
+    max_angle: f64,
+) -> OccupancyGrid {
+    let mut out = map.clone();
+    let (w, h) = (map.width(), map.height());
+    for (i, cell) in out.cells_mut().iter_mut().enumerate() {
+        let p = DVec2::new((i % w) as f64, (i / w) as f64);
+        let u = if vertical_cut {
+            p.x - pivot.x
+        } else {
+            p.y - pivot.y
+        };
+        // Where the cell came from: turned back by its angle.
+        let q = pivot + DVec2::from_angle(-max_angle * u / half).rotate(p - pivot);
+        let (qx, qy) = (q.x.round(), q.y.round());
+        *cell = if qx >= 0.0 && qy >= 0.0 && (qx as usize) < w && (qy as usize) < h {
+            map.cells()[qy as usize * w + qx as usize]
+        } else {
+            UNKNOWN
+        };
+    }
+    out
 }
 
 #[cfg(test)]
@@ -217,6 +277,52 @@ mod tests {
                 &map,
                 &CropConfig {
                     overlap: 1.0,
+                    ..config
+                },
+                1
+            ),
+            Err(Error::Config(_))
+        ));
+    }
+
+    #[test]
+    fn a_bent_part_turns_its_ends_and_keeps_its_middle() {
+        let map = room();
+        let straight = crop_pair(&map, &CropConfig::default(), 3).unwrap();
+        let config = CropConfig {
+            bend_deg: 8.0,
+            ..CropConfig::default()
+        };
+        let pair = crop_pair(&map, &config, 3).unwrap();
+        // Only the second part changes, not the truth.
+        assert_eq!(
+            (&pair.a, pair.truth, pair.overlap),
+            (&straight.a, straight.truth, straight.overlap)
+        );
+        assert_ne!(pair.b, straight.b);
+        // The room's posts of the second part, unbent and bent: the bend moves them by up to
+        // the part's half extent times the angle, and the middle ones little.
+        let posts = |b: &OccupancyGrid| -> Vec<DVec2> {
+            let w = b.width();
+            (0..b.cells().len())
+                .filter(|&i| b.state(i % w, i / w) == CellState::Occupied)
+                .map(|i| DVec2::new((i % w) as f64, (i / w) as f64))
+                .collect()
+        };
+        let moved = |p: DVec2| {
+            posts(&pair.b)
+                .iter()
+                .map(|q| (*q - p).length())
+                .fold(f64::INFINITY, f64::min)
+        };
+        let straight_posts = posts(&straight.b);
+        let far = straight_posts.iter().map(|&p| moved(p)).fold(0.0, f64::max);
+        assert!(far > 1.0 && far < 8.0, "{far}");
+        assert!(matches!(
+            crop_pair(
+                &map,
+                &CropConfig {
+                    bend_deg: f64::NAN,
                     ..config
                 },
                 1
