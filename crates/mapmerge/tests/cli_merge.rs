@@ -436,6 +436,15 @@ fn a_map_that_shares_nothing_with_the_first_is_placed_through_another() {
     assert_eq!(statuses(&report), ["tree", "declined", "tree"], "{report}");
     let why = report["pairs"][1]["reason"].as_str().unwrap();
     assert!(why.starts_with("contradicted: "), "{why}");
+    assert!(why.contains("where maps with walls this clean"), "{why}");
+    // `--no-clean-walls` lifts that bar, and the pair is answered: wrongly, a quarter turn
+    // off, which is what the bar is for.
+    let o = common::mapmerge(&["estimate", s(&a), s(&c), "--json", "--no-clean-walls"]);
+    assert_eq!(o.status.code(), Some(0));
+    let answer: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let truth = to[0].compose(&to[2].inverse());
+    let off = rotation_error_deg(&transform(&answer["transform"]), &truth);
+    assert!((85.0..95.0).contains(&off), "{off} degrees off");
     let maps = &report["maps"];
     let reference = transform(&maps[0]["transform"]);
     let truth = reference.compose(&to[0]).compose(&to[2].inverse());
