@@ -39,8 +39,7 @@ pub fn run(args: Args) -> Result<()> {
     for run in &args.runs {
         cases.extend(load(run)?);
     }
-    print!("{}", calibrate(&cases));
-    Ok(())
+    crate::emit(&calibrate(&cases).to_string())
 }
 
 /// The counts of one confidence band.

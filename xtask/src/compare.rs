@@ -42,8 +42,7 @@ pub struct Args {
 pub fn run(args: Args) -> Result<()> {
     let before = load(&args.before)?;
     let after = load(&args.after)?;
-    print!("{}", compare(&before, &after, args.moved));
-    Ok(())
+    crate::emit(&compare(&before, &after, args.moved).to_string())
 }
 
 /// What a case came to.

@@ -1470,7 +1470,7 @@ pub fn run(args: EvalArgs) -> Result<()> {
             )?;
         }
     }
-    print!("{table}");
+    crate::emit(&table)?;
     if let Some(prefix) = &args.out {
         // Appended, not `with_extension`: a prefix such as `runs/mean_2.5` keeps its dot.
         let with = |ext: &str| {

@@ -36,6 +36,17 @@ enum Command {
     Calibrate(calibrate::Args),
 }
 
+/// Write `text` to stdout. A reader that stopped reading (`cargo xtask compare A B | head`)
+/// ends the output quietly instead of with `print!`'s panic.
+pub fn emit(text: &str) -> anyhow::Result<()> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e.into()),
+        _ => Ok(()),
+    }
+}
+
 fn main() -> anyhow::Result<()> {
     match Cli::parse().command {
         Command::Gen(args) => r#gen::run(*args),

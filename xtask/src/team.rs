@@ -297,6 +297,5 @@ pub fn run(args: Args) -> Result<()> {
         totals.star_right,
         totals.star_placed - totals.star_right
     ));
-    print!("{out}{listing}");
-    Ok(())
+    crate::emit(&format!("{out}{listing}"))
 }
