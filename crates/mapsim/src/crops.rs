@@ -318,6 +318,11 @@ mod tests {
         let straight_posts = posts(&straight.b);
         let far = straight_posts.iter().map(|&p| moved(p)).fold(0.0, f64::max);
         assert!(far > 1.0 && far < 8.0, "{far}");
+        let near = straight_posts
+            .iter()
+            .map(|&p| moved(p))
+            .fold(f64::INFINITY, f64::min);
+        assert!(near < 0.5, "{near}");
         assert!(matches!(
             crop_pair(
                 &map,
