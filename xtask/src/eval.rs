@@ -797,6 +797,9 @@ struct Outcome {
     method: String,
     seed: u64,
     achieved_overlap: f64,
+    /// Each map's share of lone wall cells (`mapmerge::ascent::lone_wall_share`, A then B):
+    /// how speckled its walls are, which sets the clean-walls bar.
+    lone_wall_shares: Option<[f64; 2]>,
     accepted: bool,
     rotation_error_deg: Option<f64>,
     displacement_error_px: Option<f64>,
@@ -1152,6 +1155,7 @@ fn run_case(
         method: method.to_string(),
         seed,
         achieved_overlap: 0.0,
+        lone_wall_shares: None,
         accepted: false,
         rotation_error_deg: None,
         displacement_error_px: None,
@@ -1182,6 +1186,10 @@ fn run_case(
         }
     };
     let (a, b, truth) = (pair.a(), pair.b(), pair.truth());
+    let lone_wall_shares = [
+        mapmerge::ascent::lone_wall_share(a),
+        mapmerge::ascent::lone_wall_share(b),
+    ];
     // What the verification and the refinement reach at best, started at the truth; the
     // same for every method.
     let (truth_verification, truth_refined_drift_px, truth_refined_verification) =
@@ -1203,6 +1211,7 @@ fn run_case(
         .map(|&method| {
             let mut out = blank(method);
             out.achieved_overlap = pair.overlap();
+            out.lone_wall_shares = Some(lone_wall_shares);
             out.truth_verification = truth_verification;
             out.truth_refined_drift_px = truth_refined_drift_px;
             out.truth_refined_verification = truth_refined_verification;
