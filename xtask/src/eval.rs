@@ -94,6 +94,12 @@ pub struct EvalArgs {
     /// changes.
     #[arg(long, value_name = "BASE,PER_LONE_SHARE|off", value_parser = clean_walls_values)]
     clean_walls: Option<CleanWallsArg>,
+    /// Override the fit an answer needs where both maps' walls are clean
+    /// (`mapmerge::verify::CleanFit`) as `LONE,WIDE`: the largest share of lone wall cells
+    /// and the least wide wall lift (`off` turns the bar off; default: the library's), to
+    /// measure what it changes.
+    #[arg(long, value_name = "LONE,WIDE|off", value_parser = clean_fit_values)]
+    clean_fit: Option<CleanFitArg>,
     /// Override the smaller overlap allowed where the walls fit crisply
     /// (`mapmerge::verify::CrispSliver`) as `OVERLAP,LIFT` (`off` holds every placement to the
     /// minimum overlap; default: the library's), to measure what it changes.
@@ -478,6 +484,23 @@ fn clean_walls_values(s: &str) -> Result<CleanWallsArg, String> {
     })))
 }
 
+/// The value of `--clean-fit`: the bar, or `None` for `off`.
+#[derive(Debug, Clone, Copy)]
+struct CleanFitArg(Option<mapmerge::verify::CleanFit>);
+
+/// `--clean-fit LONE,WIDE` (two numbers in [0, 1]) or `off`.
+fn clean_fit_values(s: &str) -> Result<CleanFitArg, String> {
+    let valid = |g: f64| (0.0..=1.0).contains(&g);
+    let expected = "a share of lone wall cells and a wide wall lift in [0, 1] (LONE,WIDE)";
+    let pair = pair_or_off(s, valid, expected)?;
+    Ok(CleanFitArg(pair.map(
+        |(max_lone_share, min_wide_wall_lift)| mapmerge::verify::CleanFit {
+            max_lone_share,
+            min_wide_wall_lift,
+        },
+    )))
+}
+
 /// The value of `--crisp-sliver`: the exception, or `None` for `off`.
 #[derive(Debug, Clone, Copy)]
 struct CrispSliverArg(Option<mapmerge::verify::CrispSliver>);
@@ -848,6 +871,9 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
     }
     if let Some(CleanWallsArg(c)) = args.clean_walls {
         config.pair.verify.clean_walls = c;
+    }
+    if let Some(CleanFitArg(c)) = args.clean_fit {
+        config.pair.verify.clean_fit = c;
     }
     if let Some(CrispSliverArg(c)) = args.crisp_sliver {
         config.pair.verify.crisp_sliver = c;
@@ -1506,8 +1532,8 @@ pub fn run(args: EvalArgs) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::{
-        Row, Source, angle_window, clean_walls_values, crisp_sliver_values, export, grey_values,
-        slug, stand_out_values,
+        Row, Source, angle_window, clean_fit_values, clean_walls_values, crisp_sliver_values,
+        export, grey_values, slug, stand_out_values,
     };
     use grid_core::io::{LoadOptions, load_map};
     use mapsim::{CaseConfig, generate_case};
@@ -1673,6 +1699,18 @@ mod tests {
         assert!(walls("0.02,-1").is_err());
         assert!(walls("0.02").is_err());
         assert!(walls("0.02,NaN").is_err());
+        let fit = |s| clean_fit_values(s).map(|a| a.0);
+        assert_eq!(fit("off"), Ok(None));
+        assert_eq!(
+            fit("0.02,0.88"),
+            Ok(Some(mapmerge::verify::CleanFit {
+                max_lone_share: 0.02,
+                min_wide_wall_lift: 0.88
+            }))
+        );
+        let want = "expected a share of lone wall cells and a wide wall lift in [0, 1] \
+                    (LONE,WIDE) or `off`, got \"0.02,1.5\"";
+        assert_eq!(fit("0.02,1.5"), Err(want.to_string()));
     }
 
     #[test]

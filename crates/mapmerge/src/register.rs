@@ -1390,6 +1390,19 @@ fn register_as_given(
                 return declined(reason, timings, candidates);
             }
         }
+        if let Some(fit) = &config.verify.clean_fit {
+            let (sa, sb) = lone_shares();
+            if fit.falls_short(v.wide_wall_lift, sa, sb) {
+                let reason = format!(
+                    "misfit: both maps draw their walls cleanly (lone wall cells {:.1} % and {:.1} %), where a right placement fits its walls at wide lift {:.2} or more; the best fits at {:.2}",
+                    100.0 * sa,
+                    100.0 * sb,
+                    fit.min_wide_wall_lift,
+                    v.wide_wall_lift
+                );
+                return declined(reason, timings, candidates);
+            }
+        }
         if let Some(bar) = v.crisp_contradiction_bar(&config.verify)
             && v.mutual_contradiction > bar
         {
@@ -1841,14 +1854,25 @@ mod tests {
     fn an_answer_with_much_wall_in_the_other_maps_free_space_is_declined() {
         // B saw an obstacle A's robot saw through: a line of wall cells across A's free space,
         // more than the wide tolerance from A's walls.
+        // Both rooms are clean (no lone wall cell), and the obstacle leaves more of B's walls
+        // beyond the wide tolerance than the clean-fit bar allows; this test is about the bar
+        // on walls in free space, which holds any map, so the clean-fit bar is lifted.
         let a = room();
         let (b, truth) = turned(&room_with_wall_across(22));
-        let with_bar = |bar: f64| {
+        let r = register(&a, &b, &pair_config(true)).unwrap();
+        let reason = r.reason.unwrap_or_default();
+        assert!(reason.starts_with("misfit: "), "{reason}");
+        let config = || {
             let mut config = pair_config(true);
+            config.pair.verify.clean_fit = None;
+            config
+        };
+        let with_bar = |bar: f64| {
+            let mut config = config();
             config.pair.verify.max_wall_contradiction = bar;
             register(&a, &b, &config).unwrap()
         };
-        let r = register(&a, &b, &pair_config(true)).unwrap();
+        let r = register(&a, &b, &config()).unwrap();
         let best = r
             .accepted
             .unwrap_or_else(|| panic!("declined: {:?}", r.reason));
