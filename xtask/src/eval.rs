@@ -821,7 +821,7 @@ struct Outcome {
     seed: u64,
     achieved_overlap: f64,
     /// Each map's share of lone wall cells (`mapmerge::ascent::lone_wall_share`, A then B):
-    /// how speckled its walls are, which sets the clean-walls bar.
+    /// how speckled its walls are, which decides the clean-walls and clean-fit bars.
     lone_wall_shares: Option<[f64; 2]>,
     accepted: bool,
     rotation_error_deg: Option<f64>,

@@ -1193,6 +1193,7 @@ pub fn verify_with_offsets(
         b.wide_base_rate,
         n_ab,
     );
+
     let (mut agree, mut both) = (0usize, 0usize);
     // A's state read from its cell classes: a cell outside the known window is unknown.
     for (&p, &sb) in b.known_samples.iter().zip(&b.known_sample_states) {
