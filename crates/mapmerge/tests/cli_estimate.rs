@@ -378,3 +378,35 @@ fn padding_a_map_with_unknown_cells_leaves_the_answer_in_place() {
         assert!((got - want).length() < 1e-6, "{got} vs {want} at {p}");
     }
 }
+
+/// Two parts of the wpi_ilab floor that share nothing (case 8005005 of `cargo xtask eval
+/// --suites crops --seed 8`), saved as map files. Both draw their walls cleanly, and the best
+/// placement, which lays one part's rooms on the other's, fits them too loosely for such
+/// maps: declined with exit 3 and the clean-fit bar's reason. `--no-clean-walls` lifts the
+/// bar, and the pair is answered, 183 px off: what the bar is for.
+#[test]
+fn parts_of_a_clean_floor_that_share_nothing_are_declined_for_their_misfit() {
+    let floor = load_map(fixture("wpi_ilab"), &LoadOptions::default()).unwrap();
+    let config = mapsim::CropConfig {
+        overlap: 0.0,
+        ..Default::default()
+    };
+    let pair = mapsim::crop_pair(&floor, &config, 8_005_005).unwrap();
+    let dir = TempDir::new().unwrap();
+    let (a, b) = (dir.path().join("west.yaml"), dir.path().join("east.yaml"));
+    save_map(&pair.a, &a).unwrap();
+    save_map(&pair.b, &b).unwrap();
+    let out = run(&[&a, &b]);
+    let v = json(&out);
+    assert_eq!(out.status.code(), Some(3), "{v}");
+    let reason = v["reason"].as_str().unwrap();
+    assert!(
+        reason.starts_with("misfit: both maps draw their walls cleanly (lone wall cells"),
+        "{reason}"
+    );
+    let out = common::mapmerge(&["estimate", s(&a), s(&b), "--json", "--no-clean-walls"]);
+    let v = json(&out);
+    assert_eq!(out.status.code(), Some(0), "{v}");
+    let disp = displacement_error(&pair.b, &transform(&v), &pair.truth).unwrap();
+    assert!(disp > 100.0, "{disp} px off");
+}
