@@ -2,7 +2,9 @@
 //! `confidence` of `mapmerge estimate`) says about its error, from runs of `cargo xtask eval
 //! --out`: per confidence band, how many accepted answers were within 3 px of the truth, 3-10
 //! px off (the right place, imprecise), more than 10 px off (the wrong place), or answers to
-//! pairs that share nothing and must be declined.
+//! pairs that share nothing and must be declined. With `--wide` the bands are of the wide
+//! wall lift instead, and with `--max-lone F` only pairs whose maps both have at most F lone
+//! wall cells count: how the clean-fit bar (`mapmerge::verify::CleanFit`) was chosen.
 
 use std::collections::BTreeMap;
 use std::fmt;
@@ -25,13 +27,23 @@ same suite, row, method and seed) counts once. Only accepted answers are counted
 band of its confidence (wall lift, clamped to [0, 1]). A pair accepted with a wall lift below
 0.65 passed by the wide tolerance or stood out (see README, \"How a pair is accepted\").
 
-Example:
+Examples:
   cargo xtask regress --out /tmp/batch
-  cargo xtask calibrate /tmp/batch")]
+  cargo xtask calibrate /tmp/batch
+  cargo xtask regress --out /tmp/unbarred -- --clean-fit off
+  cargo xtask calibrate --wide --max-lone 0.02 /tmp/unbarred")]
 pub struct Args {
     /// Runs of `cargo xtask eval --out`: .jsonl files or directories of them.
     #[arg(required = true)]
     runs: Vec<PathBuf>,
+    /// Band the answers by their wide wall lift (the lift at the wide tolerance) instead of
+    /// their wall lift.
+    #[arg(long)]
+    wide: bool,
+    /// Count only pairs whose maps both have at most this share of lone wall cells (lines
+    /// without the shares are left out).
+    #[arg(long, value_name = "F")]
+    max_lone: Option<f64>,
 }
 
 pub fn run(args: Args) -> Result<()> {
@@ -39,7 +51,20 @@ pub fn run(args: Args) -> Result<()> {
     for run in &args.runs {
         cases.extend(load(run)?);
     }
-    crate::emit(&calibrate(&cases).to_string())
+    let by = Measure {
+        wide: args.wide,
+        max_lone: args.max_lone,
+    };
+    crate::emit(&calibrate(&cases, by).to_string())
+}
+
+/// Which lift bands the answers and which pairs count.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Measure {
+    /// Band by the wide wall lift, not the wall lift.
+    pub wide: bool,
+    /// Only pairs whose maps both have at most this share of lone wall cells.
+    pub max_lone: Option<f64>,
 }
 
 /// The counts of one confidence band.
@@ -72,6 +97,7 @@ impl Band {
 /// those accepted without a confidence (lines that lack the best candidate).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Calibration {
+    pub measure: Measure,
     pub bands: BTreeMap<usize, Band>,
     pub cases: usize,
     pub without_confidence: usize,
@@ -83,11 +109,20 @@ fn band_of(confidence: f64) -> usize {
     EDGES.iter().rposition(|&e| c >= e).unwrap_or(0)
 }
 
-/// Count the accepted answers of `cases` by confidence band; a case held twice (same suite,
-/// row, method and seed) counts once, as its last line.
-pub fn calibrate(cases: &[Case]) -> Calibration {
-    let unique: BTreeMap<_, &Case> = cases.iter().map(|c| (c.key(), c)).collect();
+/// Count the accepted answers of `cases` by band of the lift `by` names, over the pairs it
+/// keeps; a case held twice (same suite, row, method and seed) counts once, as its last line.
+pub fn calibrate(cases: &[Case], by: Measure) -> Calibration {
+    let kept = |c: &Case| match by.max_lone {
+        None => true,
+        Some(f) => c.lone_wall_shares.is_some_and(|[a, b]| a.max(b) <= f),
+    };
+    let unique: BTreeMap<_, &Case> = cases
+        .iter()
+        .filter(|c| kept(c))
+        .map(|c| (c.key(), c))
+        .collect();
     let mut out = Calibration {
+        measure: by,
         cases: unique.len(),
         ..Calibration::default()
     };
@@ -96,10 +131,13 @@ pub fn calibrate(cases: &[Case]) -> Calibration {
             out.without_confidence += 1;
             continue;
         };
-        let band = out
-            .bands
-            .entry(band_of(best.verification.wall_lift))
-            .or_default();
+        let v = &best.verification;
+        let lift = if by.wide {
+            v.wide_wall_lift
+        } else {
+            v.wall_lift
+        };
+        let band = out.bands.entry(band_of(lift)).or_default();
         match case.displacement_error_px {
             _ if case.row.contains("(must decline)") => band.unshared += 1,
             Some(d) if d <= 3.0 => band.within += 1,
@@ -112,10 +150,15 @@ pub fn calibrate(cases: &[Case]) -> Calibration {
 
 impl fmt::Display for Calibration {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let lift = if self.measure.wide {
+            "wide wall lift"
+        } else {
+            "confidence (wall lift)"
+        };
         writeln!(
             f,
-            "| confidence (wall lift) | answers | within 3 px | 3-10 px off | more than 10 px off | \
-             to pairs that share nothing |\n|---|---|---|---|---|---|"
+            "| {lift} | answers | within 3 px | 3-10 px off | more than 10 px off | to pairs \
+             that share nothing |\n|---|---|---|---|---|---|"
         )?;
         let pct = |n: usize, d: usize| format!("{n} ({:.0} %)", 100.0 * n as f64 / d as f64);
         let line = |f: &mut fmt::Formatter<'_>, label: &str, b: &Band| {
@@ -138,9 +181,13 @@ impl fmt::Display for Calibration {
         if all.answers() > 0 {
             line(f, "all", &all)?;
         }
+        let kept = match self.measure.max_lone {
+            Some(l) => format!(" whose maps both have at most {l} lone wall cells"),
+            None => String::new(),
+        };
         writeln!(
             f,
-            "\n{} cases, {} answers{}.",
+            "\n{} cases{kept}, {} answers{}.",
             self.cases,
             all.answers(),
             if self.without_confidence > 0 {
@@ -171,9 +218,45 @@ mod tests {
             displacement_error_px: Some(d),
             error: None,
             best: Some(Best {
-                verification: BestVerification { wall_lift: lift },
+                verification: BestVerification {
+                    wall_lift: lift,
+                    wide_wall_lift: lift,
+                },
             }),
+            lone_wall_shares: Some([0.0, 0.0]),
         }
+    }
+
+    #[test]
+    fn the_wide_lift_bands_answers_of_clean_pairs_only_when_asked() {
+        let row = "wpi_ilab cut in two, overlap 0 (must decline)";
+        let mut wrong = answer(row, 1, 0.6, 180.0);
+        wrong.best.as_mut().unwrap().verification.wide_wall_lift = 0.86;
+        let mut speckled = answer("disaster, overlap 0.3", 2, 0.7, 1.0);
+        speckled.lone_wall_shares = Some([0.01, 0.05]);
+        let mut unknown = answer("disaster, overlap 0.3", 3, 0.7, 1.0);
+        unknown.lone_wall_shares = None;
+        let cases = [wrong, speckled, unknown];
+        let by = Measure {
+            wide: true,
+            max_lone: Some(0.02),
+        };
+        let c = calibrate(&cases, by);
+        assert_eq!(c.cases, 1);
+        let unshared = Band {
+            unshared: 1,
+            ..Band::default()
+        };
+        assert_eq!(c.bands.get(&band_of(0.86)), Some(&unshared));
+        assert!(c.to_string().starts_with("| wide wall lift |"));
+        assert!(
+            c.to_string()
+                .contains("1 cases whose maps both have at most 0.02 lone")
+        );
+        // Without the filter all three count, banded by their wall lift.
+        let c = calibrate(&cases, Measure::default());
+        assert_eq!(c.cases, 3);
+        assert_eq!(c.bands.get(&band_of(0.6)), Some(&unshared));
     }
 
     #[test]
@@ -207,7 +290,7 @@ mod tests {
             failed,
             bare,
         ];
-        let c = calibrate(&cases);
+        let c = calibrate(&cases, Measure::default());
         assert_eq!(c.cases, 8);
         assert_eq!(c.without_confidence, 1);
         let band = |i| c.bands.get(&i).copied().unwrap_or_default();

@@ -83,6 +83,9 @@ pub struct Case {
     /// The best candidate (the answer, when accepted); `None` in lines that lack it.
     #[serde(default)]
     pub best: Option<Best>,
+    /// Both maps' shares of lone wall cells; `None` in lines written before they were.
+    #[serde(default)]
+    pub lone_wall_shares: Option<[f64; 2]>,
 }
 
 /// The best candidate of a case, as far as `cargo xtask calibrate` reads it.
@@ -96,6 +99,8 @@ pub struct Best {
 pub struct BestVerification {
     /// Its wall lift: the `confidence` of `mapmerge estimate` (clamped to [0, 1] there).
     pub wall_lift: f64,
+    /// Its wall lift at the wide tolerance.
+    pub wide_wall_lift: f64,
 }
 
 impl Case {
@@ -312,6 +317,7 @@ mod tests {
             displacement_error_px: d,
             error: None,
             best: None,
+            lone_wall_shares: None,
         }
     }
 
