@@ -4,7 +4,10 @@
 //! px off (the right place, imprecise), more than 10 px off (the wrong place), or answers to
 //! pairs that share nothing and must be declined. With `--wide` the bands are of the wide
 //! wall lift instead, and with `--max-lone F` only pairs whose maps both have at most F lone
-//! wall cells count: how the clean-fit bar (`mapmerge::verify::CleanFit`) was chosen.
+//! wall cells count: how the clean-fit bar (`mapmerge::verify::CleanFit`) was chosen. With
+//! `--declined` it looks at the declined pairs instead: how well the right placement fitted
+//! where one was found, against how well a wrong one fits where the maps share nothing (what
+//! a lower bar would let in).
 
 use std::collections::BTreeMap;
 use std::fmt;
@@ -12,6 +15,8 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use clap::Parser;
+
+use mapmerge::verify::{Verification, VerifyConfig};
 
 use crate::compare::{Case, load};
 
@@ -31,7 +36,9 @@ Examples:
   cargo xtask regress --out /tmp/batch
   cargo xtask calibrate /tmp/batch
   cargo xtask regress --out /tmp/unbarred -- --clean-fit off
-  cargo xtask calibrate --wide --max-lone 0.02 /tmp/unbarred")]
+  cargo xtask calibrate --wide --max-lone 0.02 /tmp/unbarred
+  cargo xtask eval --suites overlap,zero --noise 0.2 --out /tmp/n20
+  cargo xtask calibrate --declined --wide /tmp/n20.jsonl")]
 pub struct Args {
     /// Runs of `cargo xtask eval --out`: .jsonl files or directories of them.
     #[arg(required = true)]
@@ -44,6 +51,13 @@ pub struct Args {
     /// without the shares are left out).
     #[arg(long, value_name = "F")]
     max_lone: Option<f64>,
+    /// Count the declined pairs instead, each by its best-fitting candidate that passes every
+    /// test but the wall lift bars (acceptance index, wall support, overlap; the library's
+    /// defaults): in a pair that shares something, the best of the candidates within 3 px of
+    /// the truth (a right placement found but not accepted); in a pair that shares nothing,
+    /// the best of all (the fit a wrong answer reaches there).
+    #[arg(long)]
+    declined: bool,
 }
 
 pub fn run(args: Args) -> Result<()> {
@@ -55,6 +69,9 @@ pub fn run(args: Args) -> Result<()> {
         wide: args.wide,
         max_lone: args.max_lone,
     };
+    if args.declined {
+        return crate::emit(&declined(&cases, by).to_string());
+    }
     crate::emit(&calibrate(&cases, by).to_string())
 }
 
@@ -109,18 +126,45 @@ fn band_of(confidence: f64) -> usize {
     EDGES.iter().rposition(|&e| c >= e).unwrap_or(0)
 }
 
+impl Measure {
+    /// Whether `case` is one of the pairs counted.
+    fn keeps(&self, case: &Case) -> bool {
+        match self.max_lone {
+            None => true,
+            Some(f) => case.lone_wall_shares.is_some_and(|[a, b]| a.max(b) <= f),
+        }
+    }
+
+    /// The lift this measure bands by.
+    fn lift(&self, wall_lift: f64, wide_wall_lift: f64) -> f64 {
+        if self.wide { wide_wall_lift } else { wall_lift }
+    }
+
+    fn label(&self) -> &'static str {
+        if self.wide {
+            "wide wall lift"
+        } else {
+            "confidence (wall lift)"
+        }
+    }
+}
+
+/// The cases of `cases` that `by` keeps, each once (as its last line).
+fn unique<'c>(
+    cases: &'c [Case],
+    by: &Measure,
+) -> BTreeMap<(String, String, String, u64), &'c Case> {
+    cases
+        .iter()
+        .filter(|c| by.keeps(c))
+        .map(|c| (c.key(), c))
+        .collect()
+}
+
 /// Count the accepted answers of `cases` by band of the lift `by` names, over the pairs it
 /// keeps; a case held twice (same suite, row, method and seed) counts once, as its last line.
 pub fn calibrate(cases: &[Case], by: Measure) -> Calibration {
-    let kept = |c: &Case| match by.max_lone {
-        None => true,
-        Some(f) => c.lone_wall_shares.is_some_and(|[a, b]| a.max(b) <= f),
-    };
-    let unique: BTreeMap<_, &Case> = cases
-        .iter()
-        .filter(|c| kept(c))
-        .map(|c| (c.key(), c))
-        .collect();
+    let unique = unique(cases, &by);
     let mut out = Calibration {
         measure: by,
         cases: unique.len(),
@@ -132,11 +176,7 @@ pub fn calibrate(cases: &[Case], by: Measure) -> Calibration {
             continue;
         };
         let v = &best.verification;
-        let lift = if by.wide {
-            v.wide_wall_lift
-        } else {
-            v.wall_lift
-        };
+        let lift = by.lift(v.wall_lift, v.wide_wall_lift);
         let band = out.bands.entry(band_of(lift)).or_default();
         match case.displacement_error_px {
             _ if case.row.contains("(must decline)") => band.unshared += 1,
@@ -150,11 +190,7 @@ pub fn calibrate(cases: &[Case], by: Measure) -> Calibration {
 
 impl fmt::Display for Calibration {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let lift = if self.measure.wide {
-            "wide wall lift"
-        } else {
-            "confidence (wall lift)"
-        };
+        let lift = self.measure.label();
         writeln!(
             f,
             "| {lift} | answers | within 3 px | 3-10 px off | more than 10 px off | to pairs \
@@ -202,6 +238,115 @@ impl fmt::Display for Calibration {
     }
 }
 
+/// The declined pairs of runs, by their best fit (`cargo xtask calibrate --declined`).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Declined {
+    pub measure: Measure,
+    /// Per band (by its index in [`EDGES`]): the declined pairs that share something whose
+    /// right placement fits in it, and the pairs that share nothing whose best fit does.
+    pub bands: BTreeMap<usize, (usize, usize)>,
+    /// Declined pairs that share something.
+    pub shared: usize,
+    /// Declined pairs that share nothing.
+    pub unshared: usize,
+    /// The right placements' fits, lowest first.
+    pub right: Vec<f64>,
+    /// The best fit of each pair that shares nothing, lowest first.
+    pub wrong: Vec<f64>,
+}
+
+/// Count the declined pairs of `cases` by the fit of their best candidate that passes every
+/// test but the wall lift bars ([`Verification::passes_all_but_walls`] with the library's
+/// defaults): within 3 px of the truth where the pair shares something, any where it shares
+/// nothing. A case held twice counts once, as its last line.
+pub fn declined(cases: &[Case], by: Measure) -> Declined {
+    let config = VerifyConfig::default();
+    let mut out = Declined {
+        measure: by,
+        ..Declined::default()
+    };
+    for case in unique(cases, &by)
+        .values()
+        .filter(|c| !c.accepted && c.error.is_none())
+    {
+        let shares_nothing = case.row.contains("(must decline)");
+        let counts = |v: &Verification, d: Option<f64>| {
+            v.passes_all_but_walls(&config) && (shares_nothing || d.is_some_and(|d| d <= 3.0))
+        };
+        let best = case
+            .candidates
+            .iter()
+            .filter(|(v, d)| counts(v, *d))
+            .map(|(v, _)| by.lift(v.wall_lift, v.wide_wall_lift))
+            .max_by(f64::total_cmp);
+        if shares_nothing {
+            out.unshared += 1;
+        } else {
+            out.shared += 1;
+        }
+        let Some(best) = best else { continue };
+        let band = out.bands.entry(band_of(best)).or_default();
+        if shares_nothing {
+            band.1 += 1;
+            out.wrong.push(best);
+        } else {
+            band.0 += 1;
+            out.right.push(best);
+        }
+    }
+    out.right.sort_by(f64::total_cmp);
+    out.wrong.sort_by(f64::total_cmp);
+    out
+}
+
+impl fmt::Display for Declined {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(
+            f,
+            "| {} | declined pairs that share something: the right placement | declined pairs \
+             that share nothing: the best placement |\n|---|---|---|",
+            self.measure.label()
+        )?;
+        for (&i, &(right, wrong)) in &self.bands {
+            let high = EDGES.get(i + 1).copied().unwrap_or(1.0);
+            writeln!(f, "| {:.2}-{high:.2} | {right} | {wrong} |", EDGES[i])?;
+        }
+        writeln!(f, "| all | {} | {} |", self.right.len(), self.wrong.len())?;
+        let spread = |fits: &[f64]| match (fits.first(), fits.last()) {
+            (Some(lo), Some(hi)) => format!(
+                " ({} {lo:.3}-{hi:.3}, median {:.3})",
+                self.measure.label(),
+                fits[fits.len() / 2]
+            ),
+            _ => String::new(),
+        };
+        writeln!(
+            f,
+            "\n{} declined pairs that share something: {} with a candidate within 3 px that \
+             passes every test but the wall lift bars{}.",
+            self.shared,
+            self.right.len(),
+            spread(&self.right)
+        )?;
+        writeln!(
+            f,
+            "{} declined pairs that share nothing: {} with a candidate that passes those \
+             tests{}.",
+            self.unshared,
+            self.wrong.len(),
+            spread(&self.wrong)
+        )?;
+        if let Some(&top) = self.wrong.last() {
+            let above = self.right.iter().filter(|&&r| r > top).count();
+            writeln!(
+                f,
+                "Right placements that fit better than every pair that shares nothing: {above}."
+            )?;
+        }
+        Ok(())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -224,6 +369,7 @@ mod tests {
                 },
             }),
             lone_wall_shares: Some([0.0, 0.0]),
+            candidates: Vec::new(),
         }
     }
 
@@ -257,6 +403,81 @@ mod tests {
         let c = calibrate(&cases, Measure::default());
         assert_eq!(c.cases, 3);
         assert_eq!(c.bands.get(&band_of(0.6)), Some(&unshared));
+    }
+
+    /// A candidate's scores: wide lift `wide`, passing every test but the wall bars unless
+    /// `thin` (too little overlap).
+    fn fit(wide: f64, thin: bool) -> Verification {
+        Verification {
+            wall_lift: wide - 0.2,
+            wide_wall_lift: wide,
+            wall_support: 500,
+            acceptance_index: 0.95,
+            overlap_fraction: if thin { 0.05 } else { 0.4 },
+            ..Verification::default()
+        }
+    }
+
+    #[test]
+    fn declined_pairs_are_counted_by_their_right_or_best_placement() {
+        let shared = "indoor, overlap 0.5";
+        let unshared = "indoor, overlap 0 (must decline)";
+        let decline = |row: &str, seed: u64, candidates: Vec<(Verification, Option<f64>)>| {
+            let mut c = answer(row, seed, 0.0, 0.0);
+            c.accepted = false;
+            c.success = false;
+            c.displacement_error_px = None;
+            c.best = None;
+            c.candidates = candidates;
+            c
+        };
+        let cases = vec![
+            // The right placement (within 3 px) counts, not the better-fitting wrong one, nor
+            // a right one that fails the overlap test.
+            decline(
+                shared,
+                1,
+                vec![
+                    (fit(0.9, false), Some(290.0)),
+                    (fit(0.85, true), Some(1.0)),
+                    (fit(0.72, false), Some(2.5)),
+                    (fit(0.6, false), Some(0.5)),
+                ],
+            ),
+            // No right placement found.
+            decline(shared, 2, vec![(fit(0.7, false), Some(40.0))]),
+            // Sharing nothing: the best that passes the other tests.
+            decline(
+                unshared,
+                3,
+                vec![(fit(0.95, true), None), (fit(0.66, false), None)],
+            ),
+            decline(unshared, 4, vec![(fit(0.55, false), None)]),
+            // Accepted pairs are not counted.
+            answer(shared, 5, 0.9, 1.0),
+        ];
+        let d = declined(
+            &cases,
+            Measure {
+                wide: true,
+                max_lone: None,
+            },
+        );
+        assert_eq!((d.shared, d.unshared), (2, 2));
+        assert_eq!(d.right, vec![0.72]);
+        assert_eq!(d.wrong, vec![0.55, 0.66]);
+        assert_eq!(d.bands.get(&band_of(0.72)), Some(&(1, 0)));
+        assert_eq!(d.bands.get(&band_of(0.66)), Some(&(0, 1)));
+        let text = d.to_string();
+        assert!(text.contains("2 declined pairs that share something: 1 with a candidate"));
+        assert!(
+            text.contains(
+                "Right placements that fit better than every pair that shares nothing: 1."
+            )
+        );
+        // By wall lift the same candidates count, banded 0.2 lower.
+        let d = declined(&cases, Measure::default());
+        assert_eq!(d.bands.get(&band_of(0.52)), Some(&(1, 0)));
     }
 
     #[test]

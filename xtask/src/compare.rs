@@ -86,6 +86,10 @@ pub struct Case {
     /// Both maps' shares of lone wall cells; `None` in lines written before they were.
     #[serde(default)]
     pub lone_wall_shares: Option<[f64; 2]>,
+    /// Every candidate's scores with its displacement error (`None` without a truth), best
+    /// first; empty in lines that lack them.
+    #[serde(default)]
+    pub candidates: Vec<(mapmerge::verify::Verification, Option<f64>)>,
 }
 
 /// The best candidate of a case, as far as `cargo xtask calibrate` reads it.
@@ -318,6 +322,7 @@ mod tests {
             error: None,
             best: None,
             lone_wall_shares: None,
+            candidates: Vec::new(),
         }
     }
 

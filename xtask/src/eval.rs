@@ -79,6 +79,16 @@ pub struct EvalArgs {
     /// library's), to measure what it changes.
     #[arg(long)]
     max_contradiction_excess: Option<f64>,
+    /// Override the wall lift from which a placement passes the wall bar
+    /// (`mapmerge::VerifyConfig::min_wall_lift`; default: the library's), to measure what it
+    /// changes.
+    #[arg(long)]
+    min_wall_lift: Option<f64>,
+    /// Override the wide wall lift from which a placement passes the wall bar
+    /// (`mapmerge::VerifyConfig::min_wide_wall_lift`; default: the library's), to measure what
+    /// it changes.
+    #[arg(long)]
+    min_wide_lift: Option<f64>,
     /// Override the wide wall lift below which every clearly different placement that passes
     /// rivals the best (`mapmerge::VerifyConfig::trusted_wide_wall_lift`; `0` turns it off;
     /// default: the library's), to measure what it changes.
@@ -862,6 +872,12 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
     let mut config = RegisterConfig::default();
     if let Some(r) = args.basin_ratio {
         config.pair.verify.basin_ratio = r;
+    }
+    if let Some(l) = args.min_wall_lift {
+        config.pair.verify.min_wall_lift = l;
+    }
+    if let Some(l) = args.min_wide_lift {
+        config.pair.verify.min_wide_wall_lift = l;
     }
     if let Some(w) = args.trusted_wide_lift {
         config.pair.verify.trusted_wide_wall_lift = w;

@@ -847,8 +847,9 @@ fn wall_normals(grid: &OccupancyGrid, window: (usize, usize, usize, usize)) -> V
     out
 }
 
-/// The scores of one hypothesis.
-#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
+/// The scores of one hypothesis (read back from `cargo xtask eval --out` by `cargo xtask
+/// calibrate --declined`).
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct Verification {
     /// Share of compared wall cells that land near a wall of the other map (both directions).
     pub wall_agreement: f64,
