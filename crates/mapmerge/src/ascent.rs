@@ -98,10 +98,9 @@ pub fn wall_thickness(grid: &OccupancyGrid) -> f64 {
 
 /// The share of a map's occupied cells with no occupied cell among their eight neighbours: how
 /// much of its walls a noisy range sensor broke into speckle. It grows with the sensor's noise
-/// bound (`mapsim`'s default mapper: about 0.005 without noise, 0.03-0.05 at 10 %, 0.07-0.08
-/// at 20 %, 0.10-0.13 at 30 %; scratch measurements, docs/EVALUATION.md, "Answers that push
-/// the maps apart"), so two maps of alike sensors score alike. 0 for a map without occupied
-/// cells.
+/// bound (`mapsim`'s default mapper, each map of `cargo xtask eval --out`: 0.03-0.08 at 10 %,
+/// 0.09-0.21 at 20 %, 0.16-0.30 at 30 %, 0.28-0.46 at 50 %; docs/EVALUATION.md, "Equal noise
+/// of 20 %"), so two maps of alike sensors score alike. 0 for a map without occupied cells.
 pub fn lone_wall_share(grid: &OccupancyGrid) -> f64 {
     let (w, h) = (grid.width(), grid.height());
     let occupied = |x: usize, y: usize| grid.state(x, y) == CellState::Occupied;

@@ -728,6 +728,37 @@ fn stands_out(
         .all(|o| o.verification.wide_wall_lift <= bar)
 }
 
+/// The share of lone wall cells ([`lone_wall_share`]) from which a map's walls count as
+/// speckle in a decline's reason. With `mapsim`'s default mapper each map of `cargo xtask eval
+/// --out` holds 0.03-0.08 at 10 % range noise, 0.09-0.21 at 20 %, 0.16-0.30 at 30 % and
+/// 0.28-0.46 at 50 % (docs/EVALUATION.md, "Equal noise of 20 %"): from 20 % on, right
+/// placements fit about as poorly as wrong ones, and pairs are declined that do overlap.
+pub const SPECKLED_LONE_SHARE: f64 = 0.1;
+
+/// Why no placement passed: the best one's fit against the bars it missed and, where both
+/// maps' walls are speckle (lone wall cell shares `lone`), that this is what a range sensor
+/// with strong noise leaves.
+fn unverified_reason(v: &Verification, config: &VerifyConfig, lone: (f64, f64)) -> String {
+    let mut reason = format!(
+        "no hypothesis passed verification (best: wall lift {:.2} where {:.2} passes, or {:.2} at {} px where {:.2} passes; acceptance index {:.2}; overlap {:.1}% of the smaller map)",
+        v.wall_lift,
+        config.min_wall_lift,
+        v.wide_wall_lift,
+        config.wide_tolerance_px,
+        config.min_wide_wall_lift,
+        v.acceptance_index,
+        100.0 * v.overlap_fraction
+    );
+    if lone.0.min(lone.1) >= SPECKLED_LONE_SHARE {
+        reason += &format!(
+            "; both maps' walls are speckle (lone wall cells {:.1} % and {:.1} %), as a range sensor with strong noise leaves them: there a right placement fits about as poorly as a wrong one",
+            100.0 * lone.0,
+            100.0 * lone.1
+        );
+    }
+    reason
+}
+
 fn ms(t: Instant) -> f64 {
     t.elapsed().as_secs_f64() * 1e3
 }
@@ -1435,13 +1466,7 @@ fn register_as_given(
             }
         }
         Some(best) => {
-            let v = &best.verification;
-            let reason = format!(
-                "no hypothesis passed verification (best: wall lift {:.2}, acceptance index {:.2}, overlap {:.1}% of the smaller map)",
-                v.wall_lift,
-                v.acceptance_index,
-                100.0 * v.overlap_fraction
-            );
+            let reason = unverified_reason(&best.verification, &config.verify, lone_shares());
             declined(reason, timings, candidates)
         }
         None => {
@@ -1695,6 +1720,27 @@ mod tests {
         );
         // Ties keep the given order.
         assert_eq!(screen_order(&[truth, truth, wide], &config), vec![0, 1, 2]);
+    }
+
+    #[test]
+    fn a_decline_names_the_bars_missed_and_speckle_where_both_maps_have_it() {
+        let v = Verification {
+            wall_lift: 0.42,
+            wide_wall_lift: 0.63,
+            acceptance_index: 0.96,
+            overlap_fraction: 0.511,
+            ..Verification::default()
+        };
+        let config = VerifyConfig::default();
+        assert_eq!(
+            unverified_reason(&v, &config, (0.151, 0.09)),
+            "no hypothesis passed verification (best: wall lift 0.42 where 0.65 passes, or 0.63 at 4 px where 0.80 passes; acceptance index 0.96; overlap 51.1% of the smaller map)"
+        );
+        let speckled = unverified_reason(&v, &config, (0.151, 0.16));
+        assert!(
+            speckled.ends_with("; both maps' walls are speckle (lone wall cells 15.1 % and 16.0 %), as a range sensor with strong noise leaves them: there a right placement fits about as poorly as a wrong one"),
+            "{speckled}"
+        );
     }
 
     #[test]

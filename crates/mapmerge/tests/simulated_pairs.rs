@@ -310,6 +310,22 @@ fn a_placement_that_stands_out_on_speckled_walls_is_accepted() {
     );
 }
 
+/// Case 7_001_006 of the disaster 50 % overlap row of `cargo xtask eval --suites overlap
+/// --noise 0.2 --seed 7`: both robots at 20 % range noise, the default mapper. The walls are
+/// speckle (15-16 % lone wall cells), no placement reaches the bars, and the decline says so.
+#[test]
+fn a_pair_whose_walls_are_both_speckle_is_declined_saying_so() {
+    let case = disaster_case(7_001_006, 0.5, 0.2, InverseSensorModel::default());
+    let (r, _) = registered(&case, &RegisterConfig::default());
+    let reason = r.reason.unwrap_or_default();
+    assert!(
+        r.accepted.is_none()
+            && reason.starts_with("no hypothesis passed verification")
+            && reason.contains("both maps' walls are speckle (lone wall cells 16.3 % and 14.6 %)"),
+        "{reason}"
+    );
+}
+
 /// Case `seed` of the intel_lab row of `cargo xtask eval --suites real` (the intel lab floor of
 /// `fixtures/maps` explored by two lidar robots with 10 % and 20 % range noise, half of each
 /// map shared; seeds 7_003_000 + k come from `--suites real --seed 7`).
