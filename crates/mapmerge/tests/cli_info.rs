@@ -38,8 +38,17 @@ fn info_json(args: &[&str]) -> Value {
 
 /// The wall thickness of the map `yaml`, as `mapmerge::ascent::wall_thickness` measures it.
 fn thickness(yaml: &std::path::Path) -> f64 {
-    let map = grid_core::io::load_map(yaml, &grid_core::io::LoadOptions::default()).unwrap();
-    mapmerge::ascent::wall_thickness(&map)
+    mapmerge::ascent::wall_thickness(&load(yaml))
+}
+
+/// The share of lone wall cells of the map `yaml`, as `mapmerge::ascent::lone_wall_share`
+/// measures it.
+fn lone_share(yaml: &std::path::Path) -> f64 {
+    mapmerge::ascent::lone_wall_share(&load(yaml))
+}
+
+fn load(yaml: &std::path::Path) -> grid_core::OccupancyGrid {
+    grid_core::io::load_map(yaml, &grid_core::io::LoadOptions::default()).unwrap()
 }
 
 /// (name, image extension, width, height, resolution, origin, free, occupied, unknown)
@@ -200,19 +209,24 @@ fn info_json_on_every_fixture() {
             "occupied": occupied,
             "unknown": unknown,
         });
-        // The library's measure (unit-tested on walls of known thickness), reported as is
-        // (to the last bit but one: serde_json's parser may round the last).
+        // The library's measures (unit-tested on walls of known thickness and on speckle),
+        // reported as they are (to the last bit but one: serde_json's parser may round the
+        // last).
         let mut got = got;
-        let reported = got
-            .as_object_mut()
-            .unwrap()
-            .remove("wall_thickness")
-            .and_then(|v| v.as_f64());
-        let want_thickness = thickness(&yaml);
-        assert!(
-            reported.is_some_and(|t| (t - want_thickness).abs() <= 1e-12 * want_thickness),
-            "{name}: {reported:?} against {want_thickness}"
-        );
+        for (key, want) in [
+            ("wall_thickness", thickness(&yaml)),
+            ("lone_wall_share", lone_share(&yaml)),
+        ] {
+            let reported = got
+                .as_object_mut()
+                .unwrap()
+                .remove(key)
+                .and_then(|v| v.as_f64());
+            assert!(
+                reported.is_some_and(|t| (t - want).abs() <= 1e-12 * want),
+                "{name}: {key} {reported:?} against {want}"
+            );
+        }
         assert_eq!(got, want, "{name}");
     }
 }
@@ -232,11 +246,13 @@ fn info_human_form() {
          free:       34520 (57.5%)\n\
          occupied:   3711 (6.2%)\n\
          unknown:    21769 (36.3%)\n\
-         walls:      1.13 cells thick (occupied cells per side facing free space)\n",
+         walls:      1.13 cells thick (occupied cells per side facing free space)\n\
+         speckle:    0.8% of occupied cells lone (no occupied neighbour; grows with range noise)\n",
         yaml.display(),
         fixture("wpi_ilab", "pgm").display()
     );
     assert_eq!(format!("{:.2}", thickness(&yaml)), "1.13");
+    assert_eq!(format!("{:.1}", 100.0 * lone_share(&yaml)), "0.8");
     assert_eq!(text, want);
 }
 
