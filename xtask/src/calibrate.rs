@@ -7,7 +7,7 @@
 //! wall cells count: how the clean-fit bar (`mapmerge::verify::CleanFit`) was chosen. With
 //! `--declined` it looks at the declined pairs instead: how well the right placement fitted
 //! where one was found, against how well a wrong one fits where the maps share nothing (what
-//! a lower bar would let in).
+//! a lower bar would let in); with `--lone-shares`, how speckled each row's maps are.
 
 use std::collections::BTreeMap;
 use std::fmt;
@@ -58,6 +58,10 @@ pub struct Args {
     /// the best of all (the fit a wrong answer reaches there).
     #[arg(long)]
     declined: bool,
+    /// List, per row instead, how many maps there are and the least, median and largest share
+    /// of lone wall cells among them (both maps of every case): how speckled a row's maps are.
+    #[arg(long, conflicts_with = "declined")]
+    lone_shares: bool,
 }
 
 pub fn run(args: Args) -> Result<()> {
@@ -71,6 +75,9 @@ pub fn run(args: Args) -> Result<()> {
     };
     if args.declined {
         return crate::emit(&declined(&cases, by).to_string());
+    }
+    if args.lone_shares {
+        return crate::emit(&lone_shares(&cases));
     }
     crate::emit(&calibrate(&cases, by).to_string())
 }
@@ -347,6 +354,34 @@ impl fmt::Display for Declined {
     }
 }
 
+/// Per row (suite, row and method), the maps' shares of lone wall cells: how many, the least,
+/// the median (the upper of the two middle ones) and the largest, as a Markdown table. A case
+/// held twice counts once; lines without the shares are left out.
+pub fn lone_shares(cases: &[Case]) -> String {
+    let mut rows: BTreeMap<(String, String, String), Vec<f64>> = BTreeMap::new();
+    for case in unique(cases, &Measure::default()).values() {
+        if let Some(shares) = case.lone_wall_shares {
+            rows.entry((case.suite.clone(), case.row.clone(), case.method.clone()))
+                .or_default()
+                .extend(shares);
+        }
+    }
+    let mut out = String::from(
+        "| suite | case family | method | maps | least | median | largest |\n|---|---|---|---|---|---|---|\n",
+    );
+    for ((suite, row, method), mut shares) in rows {
+        shares.sort_by(f64::total_cmp);
+        out += &format!(
+            "| {suite} | {row} | {method} | {} | {:.3} | {:.3} | {:.3} |\n",
+            shares.len(),
+            shares[0],
+            shares[shares.len() / 2],
+            shares[shares.len() - 1]
+        );
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -478,6 +513,26 @@ mod tests {
         // By wall lift the same candidates count, banded 0.2 lower.
         let d = declined(&cases, Measure::default());
         assert_eq!(d.bands.get(&band_of(0.52)), Some(&(1, 0)));
+    }
+
+    #[test]
+    fn lone_shares_are_listed_per_row_over_both_maps_of_each_case_once() {
+        let row = "disaster, overlap 0.3";
+        let mut a = answer(row, 1, 0.9, 1.0);
+        a.lone_wall_shares = Some([0.05, 0.03]);
+        let mut b = answer(row, 2, 0.9, 1.0);
+        b.lone_wall_shares = Some([0.08, 0.04]);
+        let mut unknown = answer("indoor, overlap 0.3", 3, 0.9, 1.0);
+        unknown.lone_wall_shares = None;
+        let cases = [a.clone(), b, a, unknown];
+        assert_eq!(
+            lone_shares(&cases),
+            "\
+| suite | case family | method | maps | least | median | largest |
+|---|---|---|---|---|---|---|
+| s | disaster, overlap 0.3 | hybrid | 4 | 0.030 | 0.050 | 0.080 |
+"
+        );
     }
 
     #[test]
