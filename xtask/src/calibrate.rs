@@ -385,7 +385,7 @@ pub fn lone_shares(cases: &[Case]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::compare::{Best, BestVerification};
+    use crate::compare::Best;
 
     fn answer(row: &str, seed: u64, lift: f64, d: f64) -> Case {
         Case {
@@ -398,9 +398,10 @@ mod tests {
             displacement_error_px: Some(d),
             error: None,
             best: Some(Best {
-                verification: BestVerification {
+                verification: Verification {
                     wall_lift: lift,
                     wide_wall_lift: lift,
+                    ..Verification::default()
                 },
             }),
             lone_wall_shares: Some([0.0, 0.0]),

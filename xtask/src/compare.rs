@@ -92,19 +92,11 @@ pub struct Case {
     pub candidates: Vec<(mapmerge::verify::Verification, Option<f64>)>,
 }
 
-/// The best candidate of a case, as far as `cargo xtask calibrate` reads it.
+/// The best candidate of a case, as far as `cargo xtask calibrate` reads it: its scores (its
+/// wall lift is the `confidence` of `mapmerge estimate`, clamped to [0, 1] there).
 #[derive(Debug, Clone, PartialEq, serde::Deserialize)]
 pub struct Best {
-    pub verification: BestVerification,
-}
-
-/// The scores of the best candidate that `cargo xtask calibrate` reads.
-#[derive(Debug, Clone, PartialEq, serde::Deserialize)]
-pub struct BestVerification {
-    /// Its wall lift: the `confidence` of `mapmerge estimate` (clamped to [0, 1] there).
-    pub wall_lift: f64,
-    /// Its wall lift at the wide tolerance.
-    pub wide_wall_lift: f64,
+    pub verification: mapmerge::verify::Verification,
 }
 
 impl Case {
@@ -383,6 +375,22 @@ Not compared: 1 cases only in the run before, 1 only in the run after.
         let report = compare(&cases, &cases, 0.0);
         assert!(report.changes.is_empty());
         assert!(report.to_string().starts_with("No case changed.\n"));
+    }
+
+    #[test]
+    fn an_older_line_without_some_scores_reads_them_as_zero() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("old.jsonl");
+        let line = r#"{"suite":"overlap","row":"r","method":"hybrid","seed":1,"accepted":true,"success":true,"displacement_error_px":1.0,"error":null,"best":{"verification":{"wall_lift":0.7}},"candidates":[[{"wall_lift":0.7,"acceptance_index":0.95},1.0]]}"#;
+        std::fs::write(&path, format!("{line}\n")).unwrap();
+        let cases = load(&path).unwrap();
+        let best = &cases[0].best.as_ref().unwrap().verification;
+        assert_eq!((best.wall_lift, best.wide_wall_lift), (0.7, 0.0));
+        let (v, d) = cases[0].candidates[0];
+        assert_eq!(
+            (v.acceptance_index, v.mutual_contradiction, d),
+            (0.95, 0.0, Some(1.0))
+        );
     }
 
     #[test]

@@ -847,9 +847,10 @@ fn wall_normals(grid: &OccupancyGrid, window: (usize, usize, usize, usize)) -> V
     out
 }
 
-/// The scores of one hypothesis (read back from `cargo xtask eval --out` by `cargo xtask
-/// calibrate --declined`).
+/// The scores of one hypothesis (read back from the lines of `cargo xtask eval --out` by
+/// `cargo xtask compare` and `calibrate`; a score that an older line lacks reads as 0).
 #[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(default)]
 pub struct Verification {
     /// Share of compared wall cells that land near a wall of the other map (both directions).
     pub wall_agreement: f64,
