@@ -49,7 +49,7 @@ pub struct Args {
     wide: bool,
     /// Count only pairs whose maps both have at most this share of lone wall cells (lines
     /// without the shares are left out).
-    #[arg(long, value_name = "F")]
+    #[arg(long, value_name = "F", value_parser = crate::eval::fraction::<f64>)]
     max_lone: Option<f64>,
     /// Count the declined pairs instead, each by its best-fitting candidate that passes every
     /// test but the wall lift bars (acceptance index, wall support, overlap; the library's

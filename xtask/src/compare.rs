@@ -35,7 +35,7 @@ pub struct Args {
     /// The run after the change.
     after: PathBuf,
     /// List registered cases whose displacement error moved by more than this (pixels).
-    #[arg(long, default_value_t = 0.5, value_name = "PX", value_parser = crate::eval::non_negative)]
+    #[arg(long, default_value_t = 0.5, value_name = "PX", value_parser = crate::eval::non_negative::<f64>)]
     moved: f64,
 }
 

@@ -68,36 +68,36 @@ pub struct EvalArgs {
     no_offset_scoring: bool,
     /// Override the verification's wall tolerance in pixels (default: the library's), for
     /// calibration experiments.
-    #[arg(long)]
+    #[arg(long, value_parser = positive::<f32>)]
     wall_tolerance: Option<f32>,
     /// Override the ambiguity test's basin ratio (`mapmerge::VerifyConfig::basin_ratio`; `0`
     /// turns the basin test off; default: the library's), to measure what it changes.
-    #[arg(long)]
+    #[arg(long, value_parser = non_negative::<f64>)]
     basin_ratio: Option<f64>,
     /// Override how much more wall in free space a rival may put than the best and still make
     /// a pair ambiguous (`mapmerge::VerifyConfig::max_contradiction_excess`; default: the
     /// library's), to measure what it changes.
-    #[arg(long)]
+    #[arg(long, value_parser = fraction::<f64>)]
     max_contradiction_excess: Option<f64>,
     /// Override the wall lift from which a placement passes the wall bar
     /// (`mapmerge::VerifyConfig::min_wall_lift`; default: the library's), to measure what it
     /// changes.
-    #[arg(long)]
+    #[arg(long, value_parser = fraction::<f64>)]
     min_wall_lift: Option<f64>,
     /// Override the wide wall lift from which a placement passes the wall bar
     /// (`mapmerge::VerifyConfig::min_wide_wall_lift`; default: the library's), to measure what
     /// it changes.
-    #[arg(long)]
+    #[arg(long, value_parser = fraction::<f64>)]
     min_wide_lift: Option<f64>,
     /// Override the wide wall lift below which every clearly different placement that passes
     /// rivals the best (`mapmerge::VerifyConfig::trusted_wide_wall_lift`; `0` turns it off;
     /// default: the library's), to measure what it changes.
-    #[arg(long)]
+    #[arg(long, value_parser = fraction::<f64>)]
     trusted_wide_lift: Option<f64>,
     /// Override the share of its compared walls in the other map's free space above which an
     /// answer is declined (`mapmerge::VerifyConfig::max_wall_contradiction`; `1` turns it off;
     /// default: the library's), to measure what it changes.
-    #[arg(long)]
+    #[arg(long, value_parser = fraction::<f64>)]
     max_wall_contradiction: Option<f64>,
     /// Override the contradiction bar of clean walls (`mapmerge::verify::CleanWalls`) as
     /// `BASE,PER_LONE_SHARE` (`off` turns it off; default: the library's), to measure what it
@@ -118,17 +118,17 @@ pub struct EvalArgs {
     /// Override the wall lift from which an answer's walls count as crisp and are held to the
     /// misfit bar (`mapmerge::VerifyConfig::crisp_wall_lift`; above `1` turns the rule off;
     /// default: the library's), to measure what it changes.
-    #[arg(long)]
+    #[arg(long, value_parser = non_negative::<f64>)]
     crisp_wall_lift: Option<f64>,
     /// Override the share of a crisp answer's misfit walls that may lie in the other map's
     /// free space both ways (`mapmerge::VerifyConfig::max_misfit_contradiction`; default: the
     /// library's), to measure what it changes.
-    #[arg(long)]
+    #[arg(long, value_parser = fraction::<f64>)]
     max_misfit_contradiction: Option<f64>,
     /// Override the least share of a crisp answer's walls that may lie in the other map's free
     /// space both ways (`mapmerge::VerifyConfig::min_crisp_contradiction`; default: the
     /// library's), to measure what it changes.
-    #[arg(long)]
+    #[arg(long, value_parser = fraction::<f64>)]
     min_crisp_contradiction: Option<f64>,
     /// Override the stand-out rule (`mapmerge::verify::StandOut`) as `LIFT,MARGIN`, its
     /// minimum wide wall lift and margin (default: the library's), to measure what it changes.
@@ -144,11 +144,11 @@ pub struct EvalArgs {
     /// Override how far from a wall unknown cells count as known where walls are compared
     /// (`mapmerge::VerifyConfig::shadow_px`, pixels; default: the library's), to measure what
     /// it changes.
-    #[arg(long)]
+    #[arg(long, value_parser = non_negative::<f32>)]
     shadow: Option<f32>,
     /// Override SIFT's nearest / second-nearest ratio (default: the library's), for
     /// calibration experiments.
-    #[arg(long)]
+    #[arg(long, value_parser = positive::<f32>)]
     sift_ratio: Option<f32>,
     /// Override SIFT's grey values of free, occupied and unknown cells (default: the
     /// library's, `1,0,0`), e.g. `1,0,0.5`, for calibration experiments.
@@ -187,16 +187,16 @@ pub struct EvalArgs {
     sweep_size: Option<usize>,
     /// Override the wall lift of a RANSAC answer above which the rotation sweep is skipped
     /// (default: the library's), for calibration experiments.
-    #[arg(long)]
+    #[arg(long, value_parser = non_negative::<f64>)]
     confident_lift: Option<f64>,
     /// Override what the rotation sweep charges for a wall of B on free space of A (default:
     /// the library's), for calibration experiments.
-    #[arg(long)]
+    #[arg(long, value_parser = non_negative::<f32>)]
     sweep_free_penalty: Option<f32>,
     /// Override the same charge for the Hough search and the symmetry probes (default: the
     /// library's), for calibration experiments. Needs `--global`: the probes take the global
     /// search's settings when it is on, and the defaults when it is off.
-    #[arg(long)]
+    #[arg(long, value_parser = non_negative::<f32>)]
     global_free_penalty: Option<f32>,
     /// Rank the rotation sweep's placements by their normalised correlation (see
     /// `mapmerge::global::SweepConfig::normalized`; default: the library's), to measure it.
@@ -212,30 +212,30 @@ pub struct EvalArgs {
     /// Scan the answer's angle about its overlap up to this many degrees each way
     /// (`mapmerge::TurnScan::max_deg`; `0` turns the scan off; default: the library's), to
     /// measure what it changes.
-    #[arg(long, value_name = "DEG", value_parser = non_negative)]
+    #[arg(long, value_name = "DEG", value_parser = non_negative::<f64>)]
     turn_scan: Option<f64>,
     /// The step of the angle scan, in degrees (`mapmerge::TurnScan::step_deg`; default: the
     /// library's).
-    #[arg(long, value_name = "DEG", value_parser = non_negative)]
+    #[arg(long, value_name = "DEG", value_parser = non_negative::<f64>)]
     turn_scan_step: Option<f64>,
     /// How far the overlap's walls must lie from all of B's walls for the angle scan
     /// (`mapmerge::TurnScan::min_lever_px`; default: the library's).
-    #[arg(long, value_name = "PX", value_parser = non_negative)]
+    #[arg(long, value_name = "PX", value_parser = non_negative::<f64>)]
     turn_scan_lever: Option<f64>,
     /// How much more speckled one map's walls may be than the other's for the angle scan
     /// (`mapmerge::TurnScan::max_speckle_ratio`; default: the library's).
-    #[arg(long, value_name = "RATIO", value_parser = non_negative)]
+    #[arg(long, value_name = "RATIO", value_parser = non_negative::<f64>)]
     turn_scan_speckle_ratio: Option<f64>,
     /// Scan the angle also after the Manhattan angle was taken
     /// (`mapmerge::TurnScan::keep_manhattan_angle` false).
     #[arg(long)]
     turn_scan_after_manhattan: bool,
     /// The wall thickness both maps need for the ascent (`AscentConfig::min_wall_thickness`).
-    #[arg(long, value_name = "CELLS")]
+    #[arg(long, value_name = "CELLS", value_parser = non_negative::<f64>)]
     ascent_min_thickness: Option<f64>,
     /// How much the ascent's objective weighs a contradicting wall cell
     /// (`AscentConfig::contradiction_weight`).
-    #[arg(long, value_name = "W")]
+    #[arg(long, value_name = "W", value_parser = non_negative::<f64>)]
     ascent_contradiction_weight: Option<f64>,
     /// Keep the best answer's angle from ICP instead of the walls' Hough spectra (to measure
     /// what `mapmerge::SpectrumRotation` adds).
@@ -249,7 +249,7 @@ pub struct EvalArgs {
     /// Override the contrast of each map's dominant wall direction the Manhattan angle needs
     /// (`mapmerge::ManhattanRotation::min_contrast`; default: the library's), for calibration
     /// experiments.
-    #[arg(long, value_parser = non_negative)]
+    #[arg(long, value_parser = non_negative::<f64>)]
     manhattan_min_contrast: Option<f64>,
     /// Override how far (degrees) the Manhattan angle may lie from the answer's
     /// (`mapmerge::ManhattanRotation::max_delta_deg`; default: the library's), for calibration
@@ -259,12 +259,12 @@ pub struct EvalArgs {
     /// Override the spread of the agreeing walls (pixels) from which the Manhattan angle is
     /// taken (`mapmerge::ManhattanRotation::min_lever_px`; default: the library's), for
     /// calibration experiments.
-    #[arg(long, value_parser = non_negative)]
+    #[arg(long, value_parser = non_negative::<f64>)]
     manhattan_min_lever: Option<f64>,
     /// Override how far B's known cells must reach, in spreads of the agreeing walls, for the
     /// Manhattan angle to be taken (`mapmerge::ManhattanRotation::min_reach_ratio`; default:
     /// the library's), for calibration experiments.
-    #[arg(long, value_parser = non_negative)]
+    #[arg(long, value_parser = non_negative::<f64>)]
     manhattan_min_reach: Option<f64>,
     /// Override how far (degrees) the spectrum angle may lie from the answer's (see
     /// `mapmerge::SpectrumRotation::max_delta_deg`; default: the library's), for calibration
@@ -274,12 +274,12 @@ pub struct EvalArgs {
     /// Override the wall residual (pixels) below which the spectrum angle is not taken (see
     /// `mapmerge::SpectrumRotation::min_wall_residual_px`; `0` takes it on every accepted
     /// answer, as before 2026-12-03), for calibration experiments.
-    #[arg(long, value_parser = non_negative)]
+    #[arg(long, value_parser = non_negative::<f64>)]
     spectrum_min_residual: Option<f64>,
     /// Override the spread (pixels) of the agreeing walls from which on the spectrum angle is
     /// not taken (see `mapmerge::SpectrumRotation::max_lever_px`; a large value takes it at
     /// any spread, as before 2026-12-03), for calibration experiments.
-    #[arg(long, value_parser = non_negative)]
+    #[arg(long, value_parser = non_negative::<f64>)]
     spectrum_max_lever: Option<f64>,
     /// Also refine each whole-map placement from where it was proposed (see
     /// `mapmerge::PairConfig::refine_placements_as_proposed`), to measure what it adds.
@@ -297,18 +297,18 @@ pub struct EvalArgs {
     turn_search: Option<f64>,
     /// Override the refinement's range-bias prior weight (`0` or less turns the model off;
     /// default: the library's), to measure what it adds.
-    #[arg(long)]
+    #[arg(long, value_parser = finite)]
     range_bias: Option<f64>,
     /// Override where the range-bias prior centres each map's offset, in pixels
     /// (`mapmerge::refine::RefineConfig::range_bias_mean_px`; default: the library's, 0). With
     /// a large `--range-bias` the offsets stay there: the walls of both maps are then taken to
     /// sit that far behind the obstacle faces.
-    #[arg(long)]
+    #[arg(long, value_parser = finite)]
     range_bias_mean: Option<f64>,
     /// Override the correlative local search's kernel width in pixels, for both its searches
     /// (`mapmerge::search::SearchConfig::sigma_px`; default: the library's), for calibration
     /// experiments.
-    #[arg(long)]
+    #[arg(long, value_parser = positive::<f64>)]
     search_sigma: Option<f64>,
     /// Override how many wall cells per map the correlative local search compares on its finer
     /// levels, for both its searches (`mapmerge::search::SearchConfig::max_points`; default:
@@ -318,18 +318,18 @@ pub struct EvalArgs {
     /// Override the largest translation the correlative local search tries along each axis, in
     /// pixels, for both its searches (`mapmerge::search::SearchConfig::radius_px`; default: the
     /// library's), for calibration experiments.
-    #[arg(long, value_name = "PX", value_parser = non_negative)]
+    #[arg(long, value_name = "PX", value_parser = non_negative::<f64>)]
     search_radius: Option<f64>,
     /// Override how far the overlap's wall centroid must lie from all of B's walls' for the
     /// correlative local search to turn B about it, in pixels, for both its searches
     /// (`mapmerge::search::SearchConfig::overlap_pivot_px`; `inf` never; default: the
     /// library's), to measure what it changes.
-    #[arg(long)]
+    #[arg(long, value_parser = non_negative_or_inf)]
     search_overlap_pivot: Option<f64>,
     /// Override what the correlative local search subtracts per wall cell landing on known
     /// cells far from the other map's walls, for both its searches
     /// (`mapmerge::search::SearchConfig::free_penalty`; default: the library's).
-    #[arg(long)]
+    #[arg(long, value_parser = non_negative::<f64>)]
     search_free_penalty: Option<f64>,
     /// Override how many wall cells per map every ICP refinement pairs while its gate shrinks
     /// (`mapmerge::refine::RefineConfig::coarse_points`; default: the library's). A number
@@ -343,7 +343,7 @@ pub struct EvalArgs {
     refined_placements: Option<usize>,
     /// Override the step, in pixels, below which every ICP refinement stops
     /// (`mapmerge::refine::RefineConfig::tolerance_px`; default: the library's).
-    #[arg(long)]
+    #[arg(long, value_parser = positive::<f64>)]
     refine_tolerance: Option<f64>,
     /// How the simulated robots fold their beams into their maps (`default`; `hector`: gentle
     /// clearing, so noisy walls stay as speckle; `octomap`: OctoMap's probabilities, never
@@ -420,16 +420,53 @@ fn frame_margin(s: &str) -> Result<FrameMargin, String> {
     }
 }
 
-/// A finite number of pixels, 0 or more (`--spectrum-min-residual`, `--spectrum-max-lever`).
-pub(crate) fn non_negative(s: &str) -> Result<f64, String> {
-    let px: f64 = s.trim().parse().map_err(|e| format!("{s:?}: {e}"))?;
-    if px.is_finite() && px >= 0.0 {
-        Ok(px)
-    } else {
-        Err(format!(
-            "expected a finite number of pixels >= 0, got {s:?}"
-        ))
+/// A flag's number, parsed as `T` and kept when `valid`; otherwise what was `expected` and
+/// what was given (clap prefixes the flag's name). Every number an eval flag overrides goes
+/// through one of the checks below, so that a mistyped `NaN` or a negative width is refused
+/// before a run instead of silently declining every pair.
+fn checked<T>(s: &str, valid: impl Fn(f64) -> bool, expected: &str) -> Result<T, String>
+where
+    T: std::str::FromStr + Into<f64> + Copy,
+{
+    match s.trim().parse::<T>() {
+        Ok(v) if valid(v.into()) => Ok(v),
+        _ => Err(format!("expected {expected}, got {s:?}")),
     }
+}
+
+/// A finite number (`--range-bias`, `--range-bias-mean`).
+fn finite(s: &str) -> Result<f64, String> {
+    checked(s, f64::is_finite, "a finite number")
+}
+
+/// A finite number, 0 or more (pixels, degrees, weights, ratios).
+pub(crate) fn non_negative<T>(s: &str) -> Result<T, String>
+where
+    T: std::str::FromStr + Into<f64> + Copy,
+{
+    checked(s, |v| v.is_finite() && v >= 0.0, "a finite number >= 0")
+}
+
+/// A number 0 or more, or `inf` (`--search-overlap-pivot`: `inf` never turns about the
+/// overlap).
+fn non_negative_or_inf(s: &str) -> Result<f64, String> {
+    checked(s, |v| v >= 0.0, "a number >= 0 or inf")
+}
+
+/// A finite number above 0 (kernel widths, tolerances).
+fn positive<T>(s: &str) -> Result<T, String>
+where
+    T: std::str::FromStr + Into<f64> + Copy,
+{
+    checked(s, |v| v.is_finite() && v > 0.0, "a finite number > 0")
+}
+
+/// A share or a lift, in `[0, 1]`.
+pub(crate) fn fraction<T>(s: &str) -> Result<T, String>
+where
+    T: std::str::FromStr + Into<f64> + Copy,
+{
+    checked(s, |v| (0.0..=1.0).contains(&v), "a number in [0, 1]")
 }
 
 /// Three grey values in `[0, 1]`, comma-separated (`--sift-mapping`).
@@ -1548,9 +1585,11 @@ pub fn run(args: EvalArgs) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::{
-        Row, Source, angle_window, clean_fit_values, clean_walls_values, crisp_sliver_values,
-        export, grey_values, slug, stand_out_values,
+        EvalArgs, Row, Source, angle_window, clean_fit_values, clean_walls_values,
+        crisp_sliver_values, export, finite, fraction, grey_values, non_negative,
+        non_negative_or_inf, positive, slug, stand_out_values,
     };
+    use clap::Parser;
     use grid_core::io::{LoadOptions, load_map};
     use mapsim::{CaseConfig, generate_case};
 
@@ -1677,6 +1716,121 @@ mod tests {
             angle_window("four"),
             Err("\"four\": invalid float literal".to_string())
         );
+    }
+
+    #[test]
+    fn number_flags_refuse_nan_and_values_out_of_their_range() {
+        assert_eq!(finite(" -2.5 "), Ok(-2.5));
+        assert_eq!(
+            finite("inf"),
+            Err("expected a finite number, got \"inf\"".to_string())
+        );
+        assert_eq!(non_negative::<f64>("0"), Ok(0.0));
+        assert_eq!(non_negative::<f32>("3.5"), Ok(3.5f32));
+        assert_eq!(
+            non_negative::<f64>("-1"),
+            Err("expected a finite number >= 0, got \"-1\"".to_string())
+        );
+        assert_eq!(non_negative_or_inf("inf"), Ok(f64::INFINITY));
+        assert!(non_negative_or_inf("-inf").is_err());
+        assert_eq!(positive::<f32>("2"), Ok(2.0f32));
+        assert_eq!(
+            positive::<f64>("0"),
+            Err("expected a finite number > 0, got \"0\"".to_string())
+        );
+        assert_eq!(fraction::<f64>("1"), Ok(1.0));
+        assert_eq!(
+            fraction::<f64>("1.01"),
+            Err("expected a number in [0, 1], got \"1.01\"".to_string())
+        );
+        for check in [
+            finite,
+            non_negative::<f64>,
+            non_negative_or_inf,
+            positive::<f64>,
+        ] {
+            assert!(check("NaN").is_err());
+            assert!(check("nan").is_err());
+            assert!(check("two").is_err());
+        }
+        assert!(fraction::<f32>("NaN").is_err());
+    }
+
+    /// `eval`'s arguments alone, as `cargo xtask eval` and `regress` parse them.
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        args: EvalArgs,
+    }
+
+    #[test]
+    fn every_number_an_eval_flag_overrides_is_checked_before_a_run() {
+        let parse =
+            |flag: &str, value: &str| Cli::try_parse_from(["eval", flag, value]).map(|c| c.args);
+        // Each flag, given NaN, is refused with its name and the range it takes.
+        let flags = [
+            "--wall-tolerance",
+            "--basin-ratio",
+            "--max-contradiction-excess",
+            "--min-wall-lift",
+            "--min-wide-lift",
+            "--trusted-wide-lift",
+            "--max-wall-contradiction",
+            "--crisp-wall-lift",
+            "--max-misfit-contradiction",
+            "--min-crisp-contradiction",
+            "--shadow",
+            "--sift-ratio",
+            "--confident-lift",
+            "--sweep-free-penalty",
+            "--global-free-penalty",
+            "--turn-scan",
+            "--turn-scan-step",
+            "--turn-scan-lever",
+            "--turn-scan-speckle-ratio",
+            "--ascent-min-thickness",
+            "--ascent-contradiction-weight",
+            "--manhattan-min-contrast",
+            "--manhattan-max-delta",
+            "--manhattan-min-lever",
+            "--manhattan-min-reach",
+            "--spectrum-max-delta",
+            "--spectrum-min-residual",
+            "--spectrum-max-lever",
+            "--turn-search",
+            "--range-bias",
+            "--range-bias-mean",
+            "--search-sigma",
+            "--search-radius",
+            "--search-overlap-pivot",
+            "--search-free-penalty",
+            "--refine-tolerance",
+            "--noise",
+            "--bend",
+        ];
+        for flag in flags {
+            let err = parse(flag, "NaN")
+                .err()
+                .unwrap_or_else(|| panic!("{flag} took NaN"));
+            let text = err.to_string();
+            assert!(
+                text.contains(&format!("invalid value 'NaN' for '{flag}")),
+                "{text}"
+            );
+            assert!(text.contains("expected"), "{text}");
+        }
+        // In range, the value is what the run uses.
+        let a = parse("--wall-tolerance", "2.5").unwrap();
+        assert_eq!(a.wall_tolerance, Some(2.5));
+        let a = parse("--min-wide-lift", "0.75").unwrap();
+        assert_eq!(a.min_wide_lift, Some(0.75));
+        let a = parse("--search-overlap-pivot", "inf").unwrap();
+        assert_eq!(a.search_overlap_pivot, Some(f64::INFINITY));
+        let a = parse("--range-bias", "0").unwrap();
+        assert_eq!(a.range_bias, Some(0.0));
+        // Out of range.
+        assert!(parse("--min-wall-lift", "1.5").is_err());
+        assert!(parse("--search-sigma", "0").is_err());
     }
 
     #[test]

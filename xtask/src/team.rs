@@ -29,7 +29,7 @@ pub struct Args {
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Overlap of consecutive robots' explored areas, as a fraction of the smaller
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, default_value_t = 0.5, value_parser = crate::eval::fraction::<f64>)]
     pub overlap: f64,
     /// Team sizes, comma separated
     #[arg(long, value_delimiter = ',', default_value = "3,4")]
@@ -42,7 +42,7 @@ pub struct Args {
     pub no_refine: bool,
     /// Use an accepted pair in the pose graph only at this wall lift or more [default: that
     /// of `mapmerge merge`, `TeamConfig::min_edge_lift`, 0.75]
-    #[arg(long, value_parser = crate::eval::non_negative)]
+    #[arg(long, value_parser = crate::eval::non_negative::<f64>)]
     pub min_edge_lift: Option<f64>,
     /// After the table, list every map not placed within 3 px, with each pair's outcome: its
     /// error against the truth and what the pose graph made of it
@@ -115,10 +115,6 @@ pub fn run(args: Args) -> Result<()> {
     anyhow::ensure!(
         args.robots.iter().all(|&n| (2..=8).contains(&n)),
         "--robots takes team sizes from 2 to 8"
-    );
-    anyhow::ensure!(
-        (0.0..=1.0).contains(&args.overlap),
-        "--overlap is a fraction in [0, 1]"
     );
     let mut rows = Vec::new();
     let worlds = [
