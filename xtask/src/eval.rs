@@ -89,6 +89,11 @@ pub struct EvalArgs {
     /// it changes.
     #[arg(long, value_parser = fraction::<f64>)]
     min_wide_lift: Option<f64>,
+    /// Override the acceptance index from which a placement passes
+    /// (`mapmerge::VerifyConfig::min_acceptance_index`; default: the library's), to measure
+    /// what it changes.
+    #[arg(long, value_parser = fraction::<f64>)]
+    min_acceptance_index: Option<f64>,
     /// Override the wide wall lift below which every clearly different placement that passes
     /// rivals the best (`mapmerge::VerifyConfig::trusted_wide_wall_lift`; `0` turns it off;
     /// default: the library's), to measure what it changes.
@@ -915,6 +920,9 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
     }
     if let Some(l) = args.min_wide_lift {
         config.pair.verify.min_wide_wall_lift = l;
+    }
+    if let Some(i) = args.min_acceptance_index {
+        config.pair.verify.min_acceptance_index = i;
     }
     if let Some(w) = args.trusted_wide_lift {
         config.pair.verify.trusted_wide_wall_lift = w;
