@@ -703,7 +703,7 @@ fn standing_out(
         .filter(|(_, c)| {
             c.verification.wide_wall_lift >= rule.min_wide_wall_lift
                 && c.verification.wall_density >= rule.min_wall_density
-                && c.verification.passes_all_but_walls(config)
+                && rule.passes_all_but_walls(&c.verification, config)
         })
         .max_by(|(_, x), (_, y)| x.verification.score().total_cmp(&y.verification.score()))?;
     stands_out(candidates, c, rule, config, apart).then_some(i)
@@ -722,7 +722,7 @@ fn stands_out(
     candidates
         .iter()
         .filter(|o| {
-            o.verification.passes_all_but_walls(config)
+            rule.passes_all_but_walls(&o.verification, config)
                 && apart(&o.transform, &c.transform) > rule.distance_px
         })
         .all(|o| o.verification.wide_wall_lift <= bar)
@@ -1285,9 +1285,10 @@ fn register_as_given(
     {
         // A placement that stood out keeps the angle if it stays above the rule's bars.
         let still_out = best.stands_out
-            && v.passes_all_but_walls(&config.verify)
             && config.verify.stand_out.is_some_and(|r| {
-                v.wide_wall_lift >= r.min_wide_wall_lift && v.wall_density >= r.min_wall_density
+                r.passes_all_but_walls(&v, &config.verify)
+                    && v.wide_wall_lift >= r.min_wide_wall_lift
+                    && v.wall_density >= r.min_wall_density
             });
         if v.accepted(&config.verify) || still_out {
             (best.transform, best.verification) = (t.normalized(), v);
@@ -1867,6 +1868,15 @@ mod tests {
         // ... unless that placement fails the acceptance index, and so is no placement at all.
         let failed = [at(0.0, 0.75, 0.95), at(100.0, 0.75, 0.5)];
         assert_eq!(pick(&failed), Some(0));
+        // The rule's own acceptance index bar counts, not the main one: a placement between
+        // the two is no placement to it, neither the one that stands out nor a rival.
+        let between = (config.min_acceptance_index + rule.min_acceptance_index) / 2.0;
+        assert!(config.min_acceptance_index < between && between < rule.min_acceptance_index);
+        assert_eq!(
+            pick(&[at(0.0, 0.75, 0.95), at(100.0, 0.75, between)]),
+            Some(0)
+        );
+        assert_eq!(pick(&[at(0.0, 0.75, between), at(100.0, 0.2, 0.95)]), None);
         // An overlap with too little wall in it (an eroded map's border band) never stands out.
         let mut sparse = at(0.0, 0.9, 0.95);
         sparse.verification.wall_density = rule.min_wall_density * 0.9;

@@ -43,10 +43,19 @@ pub struct VerifyConfig {
     /// pairs were registered within 3 px and no wrong placement was added (13 more answers
     /// were 3-10 px off, i.e. right but outside the success bound).
     pub min_wide_wall_lift: f64,
-    /// Minimum acceptance index to accept. Default 0.88: correct answers of `cargo xtask
-    /// eval --suites overlap,mismatch,zero,real --cases 20 --seed 3` scored at least 0.917,
-    /// while the wrong placements it accepted at 0.80 were slivers of overlap (5-7 % of the
-    /// smaller map) where a few walls happened to line up, at 0.84.
+    /// Minimum acceptance index to accept. Default 0.82. It was 0.88 until 2026-12-06, chosen
+    /// when slivers of overlap (5-7 % of the smaller map) where a few walls happened to line
+    /// up were accepted at 0.84; [`Self::min_overlap_fraction`] keeps those out since. Walls
+    /// that a noisy sensor and a gently clearing mapper leave as bands of speckle disagree
+    /// cell by cell with the other map's free space: with hector's mapper at 20-30 % range
+    /// noise the right placement of indoor pairs at 30 % overlap, refined from the truth,
+    /// scores from 0.828 and under 0.88 in 31 of 60 pairs, so that 0.88 declined pairs whose
+    /// walls passed (`cargo xtask eval --suites overlap --noise 0.2 --mapper hector`, seeds
+    /// 7-8: 13 more pairs registered within 3 px, none lost). Among the
+    /// 1,200 zero-overlap pairs of the eval sets with either mapper at 10-50 % noise, only 5
+    /// had a placement that passed the wall bars, at 0.93-0.985: the index does not decline
+    /// them (docs/EVALUATION.md, "The acceptance index bar at 0.82"). The stand-out rule keeps
+    /// 0.88 ([`StandOut::min_acceptance_index`]).
     pub min_acceptance_index: f64,
     /// Minimum number of wall cells compared (both directions together). Default 40.
     pub min_wall_support: usize,
@@ -232,6 +241,14 @@ pub struct StandOut {
     pub distance_px: f64,
     /// Minimum [`Verification::wall_density`]. Default 0.033.
     pub min_wall_density: f64,
+    /// The acceptance index from which a placement counts, both as the one that stands out
+    /// and as the others it must stand out from; the rule's own bar, in place of
+    /// [`VerifyConfig::min_acceptance_index`]. Default 0.88, the main bar when the rule was
+    /// chosen. With the main bar lowered to 0.82 (2026-12-06) and the rule following it,
+    /// more placements counted as others on speckled walls, and on hector's indoor 30 %-noise
+    /// rows at seed 7 (`cargo xtask eval --suites overlap --only indoor --noise 0.3 --mapper
+    /// hector --seed 7`) four of the answers that stood out within 3 px were declined.
+    pub min_acceptance_index: f64,
 }
 
 impl Default for StandOut {
@@ -241,7 +258,20 @@ impl Default for StandOut {
             margin: 0.3,
             distance_px: 20.0,
             min_wall_density: 0.033,
+            min_acceptance_index: 0.88,
         }
+    }
+}
+
+impl StandOut {
+    /// Whether `v` passes every test of `config` but the wall lift bars
+    /// ([`Verification::passes_all_but_walls`]), with this rule's acceptance index bar.
+    pub fn passes_all_but_walls(&self, v: &Verification, config: &VerifyConfig) -> bool {
+        let own = VerifyConfig {
+            min_acceptance_index: self.min_acceptance_index,
+            ..*config
+        };
+        v.passes_all_but_walls(&own)
     }
 }
 
@@ -253,7 +283,7 @@ impl Default for VerifyConfig {
             min_wall_lift: 0.65,
             wide_tolerance_px: 4.0,
             min_wide_wall_lift: 0.8,
-            min_acceptance_index: 0.88,
+            min_acceptance_index: 0.82,
             min_wall_support: 40,
             min_overlap_fraction: 0.15,
             crisp_sliver: Some(CrispSliver::default()),

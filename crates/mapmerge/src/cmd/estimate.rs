@@ -25,13 +25,13 @@ Output (--json): one JSON object on stdout.
   confidence       wall lift of the answer (each map's walls moved by the range-bias offset the
                    refinement fitted): 0 is what a random placement scores, 1 is perfect
                    agreement of the walls; pairs are accepted from 0.65 (or 0.8 with walls
-                   compared at 4 px), with acceptance index >= 0.88 and an overlap of at
+                   compared at 4 px), with acceptance index >= 0.82 and an overlap of at
                    least 15 % of the smaller map
   stands_out       true when no placement reached those bars and this one was accepted
                    because it stands out: lift at 4 px >= 0.7 over an overlap with walls in
                    it (wall_density >= 0.033 wall cells per cell), and every placement more
-                   than 20 px from it (mean over B's walls) lower by at least 0.3 (speckled
-                   walls of a very noisy sensor)
+                   than 20 px from it (mean over B's walls) lower by at least 0.3, each
+                   at acceptance index >= 0.88 (speckled walls of a very noisy sensor)
   verification     wall_agreement, wall_lift, wide_wall_lift, wall_contradiction (share of walls
                    landing in the other map's free space), acceptance_index, overlap_cells,
                    overlap_fraction, wall_density
