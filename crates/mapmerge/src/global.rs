@@ -278,6 +278,20 @@ struct CoarseField {
 }
 
 impl CoarseField {
+    /// A's plain field with the global search's settings (its Hough placements and the
+    /// symmetry probes' twins).
+    fn of_global(a: &PreparedMap, b: &PreparedMap, config: &GlobalConfig) -> Self {
+        Self::new(
+            a,
+            b,
+            config.coarse_size,
+            config.free_penalty,
+            false,
+            config.peak_radius,
+            &mut FftPlanner::new(),
+        )
+    }
+
     /// A's field at a scale where the larger of the sides of A's known cells' bounding box
     /// and the diagonal of B's spans `coarse_size` cells, padded so that every shift of B
     /// stays unambiguous.
@@ -807,15 +821,7 @@ pub fn global_hypotheses(
         angles.push(base);
         angles.push(base + PI);
     }
-    let field = CoarseField::new(
-        a,
-        b,
-        config.coarse_size,
-        config.free_penalty,
-        false,
-        config.peak_radius,
-        &mut FftPlanner::new(),
-    );
+    let field = CoarseField::of_global(a, b, config);
     // The angles' correlations are independent: side by side, collected in order.
     let found: Vec<Vec<Rigid2>> = angles
         .par_iter()
@@ -849,15 +855,7 @@ pub fn twins(
     if pb.len() < 10 || a.wall_samples.len() < 10 {
         return;
     }
-    let field = CoarseField::new(
-        a,
-        b,
-        config.coarse_size,
-        config.free_penalty,
-        false,
-        config.peak_radius,
-        &mut FftPlanner::new(),
-    );
+    let field = CoarseField::of_global(a, b, config);
     // The first turn is none: the other translation peaks of the placement's own angle are
     // its shifted twins (a row of alike rooms).
     // Two angles share a forward transform ([`CoarseField::correlate_pair`]).
