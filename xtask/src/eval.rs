@@ -909,69 +909,65 @@ struct Outcome {
     true_correspondences: Option<mapmerge::KindTotals>,
 }
 
+/// `field` takes `value` when a flag gave one (an override of the library's default).
+fn set<T>(field: &mut T, value: Option<T>) {
+    if let Some(v) = value {
+        *field = v;
+    }
+}
+
 /// The registration settings the flags describe (the library's defaults unless overridden).
 fn register_config(args: &EvalArgs) -> RegisterConfig {
     let mut config = RegisterConfig::default();
-    if let Some(r) = args.basin_ratio {
-        config.pair.verify.basin_ratio = r;
-    }
-    if let Some(l) = args.min_wall_lift {
-        config.pair.verify.min_wall_lift = l;
-    }
-    if let Some(l) = args.min_wide_lift {
-        config.pair.verify.min_wide_wall_lift = l;
-    }
-    if let Some(i) = args.min_acceptance_index {
-        config.pair.verify.min_acceptance_index = i;
-    }
-    if let Some(w) = args.trusted_wide_lift {
-        config.pair.verify.trusted_wide_wall_lift = w;
-    }
-    if let Some(e) = args.max_contradiction_excess {
-        config.pair.verify.max_contradiction_excess = e;
-    }
+    let verify = &mut config.pair.verify;
+    set(&mut verify.basin_ratio, args.basin_ratio);
+    set(&mut verify.min_wall_lift, args.min_wall_lift);
+    set(&mut verify.min_wide_wall_lift, args.min_wide_lift);
+    set(&mut verify.min_acceptance_index, args.min_acceptance_index);
+    set(&mut verify.trusted_wide_wall_lift, args.trusted_wide_lift);
+    set(
+        &mut verify.max_contradiction_excess,
+        args.max_contradiction_excess,
+    );
     if let Some(CleanWallsArg(c)) = args.clean_walls {
-        config.pair.verify.clean_walls = c;
+        verify.clean_walls = c;
     }
     if let Some(CleanFitArg(c)) = args.clean_fit {
-        config.pair.verify.clean_fit = c;
+        verify.clean_fit = c;
     }
     if let Some(CrispSliverArg(c)) = args.crisp_sliver {
-        config.pair.verify.crisp_sliver = c;
+        verify.crisp_sliver = c;
     }
-    if let Some(c) = args.max_wall_contradiction {
-        config.pair.verify.max_wall_contradiction = c;
-    }
-    if let Some(l) = args.crisp_wall_lift {
-        config.pair.verify.crisp_wall_lift = l;
-    }
-    if let Some(m) = args.max_misfit_contradiction {
-        config.pair.verify.max_misfit_contradiction = m;
-    }
-    if let Some(m) = args.min_crisp_contradiction {
-        config.pair.verify.min_crisp_contradiction = m;
-    }
+    set(
+        &mut verify.max_wall_contradiction,
+        args.max_wall_contradiction,
+    );
+    set(&mut verify.crisp_wall_lift, args.crisp_wall_lift);
+    set(
+        &mut verify.max_misfit_contradiction,
+        args.max_misfit_contradiction,
+    );
+    set(
+        &mut verify.min_crisp_contradiction,
+        args.min_crisp_contradiction,
+    );
     if args.no_stand_out {
-        config.pair.verify.stand_out = None;
+        verify.stand_out = None;
     }
     if args.no_reverse_sweep
         && let Some(sweep) = config.pair.sweep.as_mut()
     {
         sweep.reverse = false;
     }
-    if let Some(px) = args.shadow {
-        config.pair.verify.shadow_px = px;
-    }
+    set(&mut verify.shadow_px, args.shadow);
     if let Some((lift, margin)) = args.stand_out {
-        config.pair.verify.stand_out = Some(mapmerge::verify::StandOut {
+        verify.stand_out = Some(mapmerge::verify::StandOut {
             min_wide_wall_lift: lift,
             margin,
             ..Default::default()
         });
     }
-    if let Some(t) = args.wall_tolerance {
-        config.pair.verify.wall_tolerance_px = t;
-    }
+    set(&mut verify.wall_tolerance_px, args.wall_tolerance);
     if args.no_offset_scoring {
         config.pair.offsets_in_verification = false;
     }
@@ -984,12 +980,8 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
     if args.no_search {
         config.pair.search = None;
     }
-    if let Some(r) = args.sift_ratio {
-        config.sift.ratio = r;
-    }
-    if let Some(k) = args.top_k {
-        config.pair.ransac.top_k = k;
-    }
+    set(&mut config.sift.ratio, args.sift_ratio);
+    set(&mut config.pair.ransac.top_k, args.top_k);
     if let Some(w) = args.range_bias {
         let prior = (w > 0.0).then_some(w);
         config.pair.refine.range_bias = prior;
@@ -1000,33 +992,15 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
         config.pair.global_refine.range_bias_mean_px = px;
     }
     if let Some(sweep) = config.pair.sweep.as_mut() {
-        if let Some(k) = args.sweep_keep {
-            sweep.keep = k;
-        }
-        if let Some(k) = args.sweep_keep_normalized {
-            sweep.keep_normalized = k;
-        }
-        if let Some(p) = args.sweep_peaks {
-            sweep.translation_peaks = p;
-        }
-        if let Some(r) = args.sweep_peak_radius {
-            sweep.peak_radius = r;
-        }
-        if let Some(n) = args.sweep_screen {
-            sweep.screened = n;
-        }
-        if let Some(n) = args.sweep_size {
-            sweep.coarse_size = n;
-        }
-        if let Some(l) = args.confident_lift {
-            sweep.confident_wall_lift = l;
-        }
-        if let Some(p) = args.sweep_free_penalty {
-            sweep.free_penalty = p;
-        }
-        if let Some(n) = args.sweep_normalized {
-            sweep.normalized = n;
-        }
+        set(&mut sweep.keep, args.sweep_keep);
+        set(&mut sweep.keep_normalized, args.sweep_keep_normalized);
+        set(&mut sweep.translation_peaks, args.sweep_peaks);
+        set(&mut sweep.peak_radius, args.sweep_peak_radius);
+        set(&mut sweep.screened, args.sweep_screen);
+        set(&mut sweep.coarse_size, args.sweep_size);
+        set(&mut sweep.confident_wall_lift, args.confident_lift);
+        set(&mut sweep.free_penalty, args.sweep_free_penalty);
+        set(&mut sweep.normalized, args.sweep_normalized);
     }
     if let (Some(p), Some(global)) = (args.global_free_penalty, config.pair.global.as_mut()) {
         global.free_penalty = p;
@@ -1098,12 +1072,8 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
         .into_iter()
         .chain(config.pair.polish.as_mut().map(|p| &mut p.refine))
     {
-        if let Some(n) = args.refine_coarse_points {
-            refine.coarse_points = n;
-        }
-        if let Some(px) = args.refine_tolerance {
-            refine.tolerance_px = px;
-        }
+        set(&mut refine.coarse_points, args.refine_coarse_points);
+        set(&mut refine.tolerance_px, args.refine_tolerance);
     }
     if let Some(deg) = args.turn_search {
         config.pair.turn_search = (deg > 0.0).then(|| SearchConfig {
