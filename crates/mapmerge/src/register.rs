@@ -9,6 +9,7 @@ use grid_core::{Correspondence, CorrespondenceSource, DVec2, EvidenceKind, Occup
 use ransac_rigid::{RansacConfig, estimate_rigid};
 use sift_desc::{SiftConfig, SiftCorrespondences};
 
+use crate::Error;
 use crate::ascent::{AscentConfig, ascend, lone_wall_share, wall_thickness};
 use crate::global::{
     GlobalConfig, SweepConfig, global_hypotheses, manhattan_direction, spectrum_rotation_near,
@@ -882,17 +883,19 @@ fn unframed(t: &Rigid2, oa: DVec2, ob: DVec2) -> Rigid2 {
 
 /// Register `b` onto `a` using the correspondences of `sources`.
 ///
-/// Never fails: a pair without a trustworthy answer comes back with `accepted: None` and a
-/// reason, which the binary turns into exit code 3.
+/// Fails only for invalid settings ([`PairConfig::validate`]), before any work: a pair
+/// without a trustworthy answer comes back with `accepted: None` and a reason, which the
+/// binary turns into exit code 3.
 pub fn register_with(
     a: &OccupancyGrid,
     b: &OccupancyGrid,
     sources: &[&(dyn CorrespondenceSource + Sync)],
     config: &PairConfig,
-) -> Registration {
+) -> Result<Registration, Error> {
+    config.validate()?;
     let (Some((fa, oa)), Some((fb, ob))) = rayon::join(|| config.frame(a), || config.frame(b))
     else {
-        return register_as_given(a, b, sources, config);
+        return Ok(register_as_given(a, b, sources, config));
     };
     let mut r = register_as_given(&fa, &fb, sources, config);
     for c in r.accepted.iter_mut().chain(r.candidates.iter_mut()) {
@@ -901,7 +904,7 @@ pub fn register_with(
     for m in &mut r.matches {
         (m.a, m.b) = (m.a + oa, m.b + ob);
     }
-    r
+    Ok(r)
 }
 
 /// [`register_with`] on the maps as given (no frames).
@@ -1534,13 +1537,14 @@ pub struct RegisterConfig {
 
 /// Register `b` onto `a` with the method of `config`.
 ///
-/// Fails only for an invalid SIFT configuration; a pair without a trustworthy answer comes
-/// back with `accepted: None` and a reason.
+/// Fails only for invalid settings ([`RegisterConfig::validate`]), before any work; a pair
+/// without a trustworthy answer comes back with `accepted: None` and a reason.
 pub fn register(
     a: &OccupancyGrid,
     b: &OccupancyGrid,
     config: &RegisterConfig,
-) -> Result<Registration, sift_desc::Error> {
+) -> Result<Registration, Error> {
+    config.validate()?;
     let sift = SiftCorrespondences::new(config.sift.clone())?;
     let blobs = BlobCorrespondences {
         blobs: Blobs::new(config.blobs),
@@ -1551,7 +1555,7 @@ pub fn register(
         Method::Blobs => vec![&blobs],
         Method::Hybrid => vec![&sift, &blobs],
     };
-    Ok(register_with(a, b, &sources, &config.pair))
+    register_with(a, b, &sources, &config.pair)
 }
 
 #[cfg(test)]
@@ -1970,7 +1974,7 @@ mod tests {
                 spectrum_rotation: None,
                 ..PairConfig::default()
             };
-            register_with(&a, &b, &[], &config)
+            register_with(&a, &b, &[], &config).expect("valid settings")
         };
         let all = register(None);
         let one = register(Some(1));

@@ -2,28 +2,11 @@
 //! per map from the accepted pairs ([`fusion::solve_poses`]), then the placed maps fused
 //! ([`fusion::fuse`]).
 
-use fusion::{
-    FusedMap, FusionConfig, FusionError, MapPlacement, PairEdge, PoseGraphConfig, PoseGraphSolution,
-};
+use fusion::{FusedMap, FusionConfig, MapPlacement, PairEdge, PoseGraphConfig, PoseGraphSolution};
 use grid_core::{DVec2, OccupancyGrid};
 use rayon::prelude::*;
 
-use crate::{RegisterConfig, Registration, register};
-
-/// What can go wrong when merging a team (the maps themselves are the caller's to check: each
-/// needs known cells, all the same resolution).
-#[derive(Debug, thiserror::Error)]
-pub enum Error {
-    /// The registration settings are invalid.
-    #[error("invalid registration settings: {0}")]
-    Config(#[from] sift_desc::Error),
-    /// Fusing the maps or solving their poses failed.
-    #[error(transparent)]
-    Fusion(#[from] FusionError),
-    /// `weights` does not give one weight per map, or the reference is not a map.
-    #[error("{0}")]
-    Input(String),
-}
+use crate::{Error, RegisterConfig, Registration, register};
 
 /// Settings of [`merge_team`].
 #[derive(Debug, Clone)]
@@ -121,6 +104,7 @@ pub fn merge_team(
     config: &TeamConfig,
     on_pair: &(dyn Fn() + Sync),
 ) -> Result<TeamMerge, Error> {
+    config.validate()?;
     if weights.len() != maps.len() {
         return Err(Error::Input(format!(
             "{} weights for {} maps: give one per map",

@@ -327,7 +327,7 @@ fn registers_from_area_evidence_alone() {
         global: None,
         ..PairConfig::default()
     };
-    let r = register_with(&a, &b, &sources, &config);
+    let r = register_with(&a, &b, &sources, &config).expect("valid settings");
     let c = r.accepted.expect("accepted from blob evidence");
     assert_eq!(c.origin, mapmerge::Origin::Ransac);
     assert_eq!(r.correspondences.intensity, 0);

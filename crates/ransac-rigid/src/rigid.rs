@@ -88,7 +88,9 @@ fn non_negative(x: f64) -> bool {
 }
 
 impl RansacConfig {
-    fn validate(&self) -> Result<(), RansacError> {
+    /// Checks every setting: `Err(RansacError::InvalidConfig)` naming the first out of range.
+    /// [`estimate_rigid`] calls it first.
+    pub fn validate(&self) -> Result<(), RansacError> {
         let bad = |msg| Err(RansacError::InvalidConfig(msg));
         if !(self.threshold_px.is_finite() && self.threshold_px > 0.0) {
             return bad("threshold_px must be finite and positive");

@@ -238,7 +238,7 @@ pub fn run(args: &MergeArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode> {
     bar.finish_and_clear();
     let merged = match merged {
         Ok(m) => m,
-        Err(mapmerge::team::Error::Fusion(e)) => {
+        Err(mapmerge::Error::Fusion(e)) => {
             return Err(UsageError(format!(
                 "{}: cannot merge the maps: {e}",
                 args.output.display()
