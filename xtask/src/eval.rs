@@ -221,7 +221,7 @@ pub struct EvalArgs {
     turn_scan: Option<f64>,
     /// The step of the angle scan, in degrees (`mapmerge::TurnScan::step_deg`; default: the
     /// library's).
-    #[arg(long, value_name = "DEG", value_parser = non_negative::<f64>)]
+    #[arg(long, value_name = "DEG", value_parser = positive::<f64>)]
     turn_scan_step: Option<f64>,
     /// How far the overlap's walls must lie from all of B's walls for the angle scan
     /// (`mapmerge::TurnScan::min_lever_px`; default: the library's).
