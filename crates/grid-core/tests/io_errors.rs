@@ -88,6 +88,29 @@ fn missing_image_named_in_yaml_names_both_files() {
     );
 }
 
+/// A directory opens on Unix and fails on the first read (EISDIR, 21 on Linux and macOS).
+#[cfg(unix)]
+#[test]
+fn an_image_name_that_is_a_directory_names_both_files() {
+    let dir = TempDir::new().unwrap();
+    std::fs::create_dir(dir.path().join("maps")).unwrap();
+    let yaml = write(
+        &dir,
+        "map.yaml",
+        replace_key("image", "image: maps").as_bytes(),
+    );
+    let msg = err(&yaml);
+    let image = dir.path().join("maps");
+    assert!(msg.starts_with(&format!("{}: ", image.display())), "{msg}");
+    assert!(
+        msg.ends_with(&format!(
+            "Is a directory (os error 21) (image named in {})",
+            yaml.display()
+        )),
+        "{msg}"
+    );
+}
+
 #[test]
 fn unknown_extension() {
     let dir = TempDir::new().unwrap();

@@ -182,7 +182,7 @@ pub fn read_image(
     options: &LoadOptions,
     yaml: Option<&Path>,
 ) -> Result<OccupancyGrid> {
-    let file = File::open(image_path).map_err(|source| Error::Io {
+    let io_error = |source: std::io::Error| Error::Io {
         path: image_path.to_path_buf(),
         source: match yaml {
             // Say where the name came from: the user typed the YAML's name, not this one.
@@ -192,12 +192,11 @@ pub fn read_image(
             ),
             None => source,
         },
-    })?;
+    };
+    let file = File::open(image_path).map_err(io_error)?;
     let mut reader = BufReader::new(file);
-    let head = reader.fill_buf().map_err(|source| Error::Io {
-        path: image_path.to_path_buf(),
-        source,
-    })?;
+    // A directory opens, and fails on the first read.
+    let head = reader.fill_buf().map_err(io_error)?;
     let raster = if head.is_empty() {
         return Err(format_error(image_path, "empty file (0 bytes)"));
     } else if head.starts_with(b"\x89PNG") {
