@@ -371,10 +371,11 @@ impl OccupancyGrid {
                 let (xf, yf) = (x as f64, y as f64);
                 let sx = (c * xf - s * yf + inv.tx).round();
                 let sy = (s * xf + c * yf + inv.ty).round();
-                if sx >= 0.0 && sy >= 0.0 {
-                    if let Some(v) = self.get(sx as usize, sy as usize) {
-                        *cell = v;
-                    }
+                if sx >= 0.0
+                    && sy >= 0.0
+                    && let Some(v) = self.get(sx as usize, sy as usize)
+                {
+                    *cell = v;
                 }
             }
         }

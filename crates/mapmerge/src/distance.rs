@@ -383,7 +383,7 @@ mod tests {
                 let r = s >> 33;
                 cells[y * w + x] = if site(x, y, r) {
                     100
-                } else if r % 11 == 0 {
+                } else if r.is_multiple_of(11) {
                     UNKNOWN
                 } else {
                     0
@@ -410,10 +410,10 @@ mod tests {
             s = s
                 .wrapping_mul(6364136223846793005)
                 .wrapping_add(1442695040888963407);
-            if (s >> 40) % 29 == 0 {
+            if (s >> 40).is_multiple_of(29) {
                 *cell = 100;
                 sites.push((i % w, i / w));
-            } else if (s >> 40) % 7 == 0 {
+            } else if (s >> 40).is_multiple_of(7) {
                 *cell = UNKNOWN;
             }
         }

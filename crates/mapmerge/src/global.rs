@@ -1140,7 +1140,7 @@ mod tests {
         let smooth = |m: usize| {
             let mut m = m;
             for p in [2, 3, 5] {
-                while m % p == 0 {
+                while m.is_multiple_of(p) {
                     m /= p;
                 }
             }

@@ -51,7 +51,7 @@ pub(crate) fn footprint_stride(cfg: &RobotConfig, pose_step: f64) -> usize {
 /// Whether a robot driving the tour backwards (heading + pi) sees the same footprint as one
 /// driving it forwards: true when its beams are symmetric under a half turn.
 pub(crate) fn flip_invariant(cfg: &RobotConfig) -> bool {
-    cfg.beams % 2 == 0 && cfg.failed_beams.is_empty()
+    cfg.beams.is_multiple_of(2) && cfg.failed_beams.is_empty()
 }
 
 /// Footprints of poses `range` of `tour` (headings already in the robot's direction); only
@@ -74,7 +74,7 @@ pub(crate) fn footprints(
             || vec![false; raster.w * raster.h],
             |stamp, (k, p)| {
                 let mut cells = Vec::new();
-                if (range.start + k) % stride != 0 {
+                if !(range.start + k).is_multiple_of(stride) {
                     return cells;
                 }
                 let heading = DVec2::from_angle(p.heading + flip);
