@@ -71,21 +71,27 @@ fn missing_file() {
     assert!(e.to_string().starts_with(&format!("{}: ", path.display())));
 }
 
+/// The error of a YAML in `dir` whose image line names `image`: it starts with the image's
+/// path and ends with what the OS said, then the YAML that named it.
+fn assert_names_both_files(dir: &TempDir, image: &str, os_says: &str) {
+    let yaml = write(
+        dir,
+        "map.yaml",
+        replace_key("image", &format!("image: {image}")).as_bytes(),
+    );
+    let msg = err(&yaml);
+    let image = dir.path().join(image);
+    assert!(msg.starts_with(&format!("{}: ", image.display())), "{msg}");
+    assert!(
+        msg.ends_with(&format!("{os_says} (image named in {})", yaml.display())),
+        "{msg}"
+    );
+}
+
 #[test]
 fn missing_image_named_in_yaml_names_both_files() {
     let dir = TempDir::new().unwrap();
-    let yaml = write(
-        &dir,
-        "map.yaml",
-        replace_key("image", "image: gone.pgm").as_bytes(),
-    );
-    let msg = err(&yaml);
-    let image = dir.path().join("gone.pgm");
-    assert!(msg.starts_with(&format!("{}: ", image.display())), "{msg}");
-    assert!(
-        msg.ends_with(&format!("(image named in {})", yaml.display())),
-        "{msg}"
-    );
+    assert_names_both_files(&dir, "gone.pgm", "No such file or directory (os error 2)");
 }
 
 /// A directory opens on Unix and fails on the first read (EISDIR, 21 on Linux and macOS).
@@ -94,21 +100,7 @@ fn missing_image_named_in_yaml_names_both_files() {
 fn an_image_name_that_is_a_directory_names_both_files() {
     let dir = TempDir::new().unwrap();
     std::fs::create_dir(dir.path().join("maps")).unwrap();
-    let yaml = write(
-        &dir,
-        "map.yaml",
-        replace_key("image", "image: maps").as_bytes(),
-    );
-    let msg = err(&yaml);
-    let image = dir.path().join("maps");
-    assert!(msg.starts_with(&format!("{}: ", image.display())), "{msg}");
-    assert!(
-        msg.ends_with(&format!(
-            "Is a directory (os error 21) (image named in {})",
-            yaml.display()
-        )),
-        "{msg}"
-    );
+    assert_names_both_files(&dir, "maps", "Is a directory (os error 21)");
 }
 
 #[test]
