@@ -797,6 +797,9 @@ mod tests {
         c.sift.ratio = 0.0;
         assert!(matches!(c.validate(), Err(Error::Sift(_))), "{c:?}");
         let mut c = RegisterConfig::default();
+        c.sift.mapping.unknown = f32::NAN;
+        assert!(matches!(c.validate(), Err(Error::Sift(_))));
+        let mut c = RegisterConfig::default();
         c.pair.ransac.confidence = 1.5;
         assert!(matches!(c.validate(), Err(Error::Ransac(_))));
     }

@@ -181,6 +181,16 @@ impl SiftConfig {
         if !(self.ratio.is_finite() && self.ratio > 0.0 && self.ratio <= 1.0) {
             return Err(Error::Config("ratio must be in (0, 1]"));
         }
+        let m = &self.mapping;
+        if ![m.free, m.occupied, m.unknown]
+            .iter()
+            .all(|v| v.is_finite())
+        {
+            // A NaN grey value spreads through every blur: no keypoint, without a word.
+            return Err(Error::Config(
+                "mapping's grey values (free, occupied, unknown) must be finite",
+            ));
+        }
         Ok(())
     }
 }
@@ -317,5 +327,45 @@ impl CorrespondenceSource for SiftCorrespondences {
         self.sift.extract_with(a, &mut space, &mut fa);
         self.sift.extract_with(b, &mut space, &mut fb);
         correspondences_from_features(&fa, &fb, &self.sift.config.match_config(), out);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_part_of_the_configuration_is_checked() {
+        SiftConfig::default().validate().unwrap();
+        let refused = |change: fn(&mut SiftConfig)| {
+            let mut c = SiftConfig::default();
+            change(&mut c);
+            match c.validate() {
+                Err(Error::Config(msg)) => msg,
+                other => panic!("not refused: {other:?}"),
+            }
+        };
+        assert_eq!(refused(|c| c.ratio = f32::NAN), "ratio must be in (0, 1]");
+        assert_eq!(
+            refused(|c| c.descriptor.peak_ratio = 1.5),
+            "peak_ratio must be in [0, 1]"
+        );
+        assert_eq!(
+            refused(|c| c.descriptor.clamp = 0.0),
+            "lambda_ori, lambda_descr and clamp must be positive"
+        );
+        for change in [
+            (|c: &mut SiftConfig| c.mapping.free = f32::NAN) as fn(&mut SiftConfig),
+            |c| c.mapping.occupied = f32::INFINITY,
+            |c| c.mapping.unknown = f32::NAN,
+        ] {
+            assert_eq!(
+                refused(change),
+                "mapping's grey values (free, occupied, unknown) must be finite"
+            );
+        }
+        let mut c = SiftConfig::default();
+        c.scale_space.n_spo = 0;
+        assert!(matches!(c.validate(), Err(Error::ScaleSpace(_))));
     }
 }
