@@ -186,7 +186,7 @@ impl SiftConfig {
             .iter()
             .all(|v| v.is_finite())
         {
-            // A NaN grey value spreads through every blur: no keypoint, without a word.
+            // A NaN grey value spreads through every blur sum.
             return Err(Error::Config(
                 "mapping's grey values (free, occupied, unknown) must be finite",
             ));
