@@ -36,6 +36,15 @@ pub enum FusionError {
         /// The weight given.
         weight: f64,
     },
+    /// A bound of [`crate::PoseGraphConfig`] that is NaN or negative (NaN would keep every
+    /// loop, a wrong one included).
+    #[error("pose graph setting {name} = {value}: must be 0 or more")]
+    Setting {
+        /// The field of [`crate::PoseGraphConfig`].
+        name: &'static str,
+        /// The value given.
+        value: f64,
+    },
     /// The reference map of the pose graph is not one of its maps.
     #[error("the reference map {reference} is not one of the {nodes} maps")]
     Reference {

@@ -100,6 +100,14 @@ pub fn solve_poses(
     edges: &[PairEdge],
     config: &PoseGraphConfig,
 ) -> Result<PoseGraphSolution> {
+    for (name, value) in [
+        ("max_rotation_deg", config.max_rotation_deg),
+        ("max_translation_px", config.max_translation_px),
+    ] {
+        if value.is_nan() || value < 0.0 {
+            return Err(FusionError::Setting { name, value });
+        }
+    }
     let n = centres.len();
     if reference >= n {
         return Err(FusionError::Reference {
@@ -381,6 +389,41 @@ mod tests {
         assert_eq!(s.status, vec![Tree, Tree, Tree, Loop, Dropped]);
         assert!(s.residuals[4].translation_px > 29.0, "{:?}", s.residuals[4]);
         assert!(worst(&s.poses, &t, DVec2::new(100.0, 80.0)) < 1e-6);
+    }
+
+    #[test]
+    fn a_bound_that_is_nan_or_negative_is_refused() {
+        let t = truth();
+        let edges = [edge(&t, 0, 1, 0.9)];
+        for (config, name) in [
+            (
+                PoseGraphConfig {
+                    max_rotation_deg: f64::NAN,
+                    ..PoseGraphConfig::default()
+                },
+                "max_rotation_deg",
+            ),
+            (
+                PoseGraphConfig {
+                    max_translation_px: -1.0,
+                    ..PoseGraphConfig::default()
+                },
+                "max_translation_px",
+            ),
+        ] {
+            let err = solve_poses(&centres(2), 0, &edges, &config).unwrap_err();
+            assert!(
+                matches!(err, FusionError::Setting { name: n, .. } if n == name),
+                "{err}"
+            );
+        }
+        // An infinite bound drops no loop.
+        let config = PoseGraphConfig {
+            max_rotation_deg: f64::INFINITY,
+            max_translation_px: f64::INFINITY,
+            ..PoseGraphConfig::default()
+        };
+        solve_poses(&centres(2), 0, &edges, &config).unwrap();
     }
 
     #[test]

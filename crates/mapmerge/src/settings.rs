@@ -362,11 +362,11 @@ impl SweepConfig {
 impl TeamConfig {
     /// Checks every setting ([`crate::settings`]): the registration's by
     /// [`RegisterConfig::validate`] (named `register.…`), the edge bar and the pose graph's
-    /// bounds here. [`crate::team::merge_team`] calls it first.
+    /// bounds (0 or more) here, before any pair is registered. [`crate::team::merge_team`] calls it first.
     pub fn validate(&self) -> Result<(), Error> {
         self.register.validate_at("register")?;
         Fields("poses").all(
-            Rule::NotNan,
+            Rule::NonNegative,
             &[
                 ("max_rotation_deg", self.poses.max_rotation_deg),
                 ("max_translation_px", self.poses.max_translation_px),
@@ -784,6 +784,12 @@ mod tests {
             team.validate(),
             Err(Error::Setting { name, .. }) if name == "register.pair.verify.min_acceptance_index"
         ));
+        let mut team = TeamConfig::default();
+        team.poses.max_translation_px = -8.0;
+        assert_eq!(
+            team.validate().unwrap_err().to_string(),
+            "invalid setting `poses.max_translation_px` = -8: must be 0 or more"
+        );
         let team = TeamConfig {
             min_edge_lift: f64::NAN,
             ..TeamConfig::default()
