@@ -1431,6 +1431,11 @@ pub fn run(args: EvalArgs) -> Result<()> {
         }
     }
     let defaults = register_config(&args);
+    // Settings the flags' parsers let through but the library refuses (a grid size of 0)
+    // stop the run here, once, instead of failing every case.
+    defaults
+        .validate()
+        .context("the flags give invalid registration settings")?;
     // A row keeps its index among the selected suites' rows with or without `--only`, so the
     // filtered run draws the same cases as the full one.
     let selected: Vec<usize> = (0..rows.len())
@@ -1809,6 +1814,22 @@ mod tests {
         // Out of range.
         assert!(parse("--min-wall-lift", "1.5").is_err());
         assert!(parse("--search-sigma", "0").is_err());
+    }
+
+    #[test]
+    fn settings_the_parsers_let_through_but_the_library_refuses_stop_the_run_at_once() {
+        let args = Cli::try_parse_from(["eval", "--sweep-size", "0", "--suites", "paper"])
+            .unwrap()
+            .args;
+        let err = super::run(args).unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "the flags give invalid registration settings"
+        );
+        assert_eq!(
+            err.root_cause().to_string(),
+            "invalid setting `pair.sweep.coarse_size` = 0: must be at least 1"
+        );
     }
 
     #[test]
