@@ -688,9 +688,8 @@ fn one_basin(
     score(&mid) >= config.basin_ratio * score(x).min(score(y))
 }
 
-/// The candidate [`StandOut`] accepts when none passed the wall lift bars: of those that pass
-/// all but the wall tests with a wide lift of at least `rule.min_wide_wall_lift` and a wall
-/// density of at least `rule.min_wall_density`, the best scoring, if it [`stands_out`].
+/// The candidate [`StandOut`] accepts when none passed the wall lift bars: of those the rule
+/// admits ([`StandOut::admits`]), the best scoring, if it [`stands_out`].
 /// `apart` measures how far apart two placements put B's walls.
 fn standing_out(
     candidates: &[Candidate],
@@ -701,11 +700,7 @@ fn standing_out(
     let (i, c) = candidates
         .iter()
         .enumerate()
-        .filter(|(_, c)| {
-            c.verification.wide_wall_lift >= rule.min_wide_wall_lift
-                && c.verification.wall_density >= rule.min_wall_density
-                && rule.passes_all_but_walls(&c.verification, config)
-        })
+        .filter(|(_, c)| rule.admits(&c.verification, config))
         .max_by(|(_, x), (_, y)| x.verification.score().total_cmp(&y.verification.score()))?;
     stands_out(candidates, c, rule, config, apart).then_some(i)
 }
@@ -1288,11 +1283,10 @@ fn register_as_given(
     {
         // A placement that stood out keeps the angle if it stays above the rule's bars.
         let still_out = best.stands_out
-            && config.verify.stand_out.is_some_and(|r| {
-                r.passes_all_but_walls(&v, &config.verify)
-                    && v.wide_wall_lift >= r.min_wide_wall_lift
-                    && v.wall_density >= r.min_wall_density
-            });
+            && config
+                .verify
+                .stand_out
+                .is_some_and(|r| r.admits(&v, &config.verify));
         if v.accepted(&config.verify) || still_out {
             (best.transform, best.verification) = (t.normalized(), v);
         }

@@ -273,6 +273,15 @@ impl StandOut {
         };
         v.passes_all_but_walls(&own)
     }
+
+    /// Whether `v` may stand out under this rule: it passes every test of `config` but the
+    /// wall lift bars ([`Self::passes_all_but_walls`]), with a wide wall lift of at least
+    /// `min_wide_wall_lift` over a wall density of at least `min_wall_density`.
+    pub fn admits(&self, v: &Verification, config: &VerifyConfig) -> bool {
+        v.wide_wall_lift >= self.min_wide_wall_lift
+            && v.wall_density >= self.min_wall_density
+            && self.passes_all_but_walls(v, config)
+    }
 }
 
 impl Default for VerifyConfig {
