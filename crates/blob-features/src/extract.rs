@@ -4,7 +4,7 @@ use grid_core::{FeatureExtractor, OccupancyGrid};
 
 use crate::label::{Connectivity, Labeler};
 use crate::moments::{Accumulator, Shape, accumulate};
-use crate::{close, not_free_mask, obstacle_mask};
+use crate::{BlobError, Result, close, not_free_mask, obstacle_mask};
 
 /// Length of the descriptor array of a [`Blob`] (unused trailing entries are zero).
 pub const DESCRIPTOR_LEN: usize = 8;
@@ -116,6 +116,33 @@ pub struct BlobConfig {
     pub unknown: UnknownPolicy,
     /// Descriptor used for matching. Default [`DescriptorKind::Axes`].
     pub descriptor: DescriptorKind,
+}
+
+impl BlobConfig {
+    /// Checks the numbers: `round_ratio` and the fraction of [`UnknownPolicy::Drop`] must not
+    /// be NaN (a NaN ratio would leave every blob without an orientation, a NaN fraction
+    /// would keep every blob, both without a word). Any other value is a bar: above 1 every
+    /// component counts as elongated, below 0 as round. [`BlobCorrespondences::new`] calls it.
+    ///
+    /// [`BlobCorrespondences::new`]: crate::BlobCorrespondences::new
+    pub fn validate(&self) -> Result<()> {
+        let not_nan = |name, value: f64| {
+            if value.is_nan() {
+                Err(BlobError::Setting {
+                    name,
+                    value,
+                    rule: "a number (not NaN)",
+                })
+            } else {
+                Ok(())
+            }
+        };
+        not_nan("round_ratio", self.round_ratio)?;
+        if let UnknownPolicy::Drop(max) = self.unknown {
+            not_nan("unknown", max)?;
+        }
+        Ok(())
+    }
 }
 
 impl Default for BlobConfig {

@@ -2,7 +2,7 @@
 
 use grid_core::{Correspondence, CorrespondenceSource, EvidenceKind, OccupancyGrid, Orientation};
 
-use crate::{Blob, BlobScratch, Blobs, DESCRIPTOR_LEN};
+use crate::{Blob, BlobConfig, BlobError, BlobScratch, Blobs, DESCRIPTOR_LEN, Result};
 
 /// Matching settings.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -30,6 +30,25 @@ impl Default for MatchConfig {
             max_distance: 0.3,
             candidates: 1,
         }
+    }
+}
+
+impl MatchConfig {
+    /// Checks the numbers: `ratio` and `max_distance` must be 0 or more (infinity allowed:
+    /// it switches the test off). Both are compared squared, so a negative value would act as
+    /// its absolute value, and a NaN would drop every match without a word.
+    /// [`BlobCorrespondences::new`] calls it.
+    pub fn validate(&self) -> Result<()> {
+        for (name, value) in [("ratio", self.ratio), ("max_distance", self.max_distance)] {
+            if value.is_nan() || value < 0.0 {
+                return Err(BlobError::Setting {
+                    name,
+                    value,
+                    rule: "0 or more",
+                });
+            }
+        }
+        Ok(())
     }
 }
 
@@ -136,6 +155,20 @@ pub struct BlobCorrespondences {
     pub blobs: Blobs,
     /// Matching settings.
     pub matching: MatchConfig,
+}
+
+impl BlobCorrespondences {
+    /// A source with the given settings, checked ([`BlobConfig::validate`],
+    /// [`MatchConfig::validate`]). The fields are public; a source built from them directly
+    /// is not checked.
+    pub fn new(blobs: BlobConfig, matching: MatchConfig) -> Result<Self> {
+        blobs.validate()?;
+        matching.validate()?;
+        Ok(Self {
+            blobs: Blobs::new(blobs),
+            matching,
+        })
+    }
 }
 
 impl CorrespondenceSource for BlobCorrespondences {

@@ -104,9 +104,16 @@ impl RegisterConfig {
     fn validate_at(&self, path: &str) -> Result<(), Error> {
         let here = Fields(path);
         self.sift.validate()?;
-        Fields(&here.path("blobs")).check("round_ratio", self.blobs.round_ratio, Rule::NotNan)?;
+        // The rules of `blob_features::BlobConfig::validate` and `MatchConfig::validate`,
+        // here to name the setting's path.
+        let blobs = Fields(&here.path("blobs"));
+        blobs.check("round_ratio", self.blobs.round_ratio, Rule::NotNan)?;
+        if let blob_features::UnknownPolicy::Drop(max) = self.blobs.unknown {
+            blobs.check("unknown", max, Rule::NotNan)?;
+        }
+        // Compared squared: a negative bar would act as its absolute value.
         Fields(&here.path("blob_matching")).all(
-            Rule::NotNan,
+            Rule::NonNegative,
             &[
                 ("ratio", self.blob_matching.ratio),
                 ("max_distance", self.blob_matching.max_distance),
@@ -410,6 +417,9 @@ mod tests {
     fn every_number_is_refused_as_nan_under_its_own_name() {
         let cases: Vec<(&str, Setter)> = vec![
             ("blobs.round_ratio", |c| c.blobs.round_ratio = f64::NAN),
+            ("blobs.unknown", |c| {
+                c.blobs.unknown = blob_features::UnknownPolicy::Drop(f64::NAN)
+            }),
             ("blob_matching.ratio", |c| c.blob_matching.ratio = f64::NAN),
             ("blob_matching.max_distance", |c| {
                 c.blob_matching.max_distance = f64::NAN
@@ -704,6 +714,12 @@ mod tests {
     #[test]
     fn steps_widths_and_grid_sizes_must_be_positive() {
         let cases: Vec<(&str, Rule, Setter)> = vec![
+            ("blob_matching.ratio", Rule::NonNegative, |c| {
+                c.blob_matching.ratio = -0.8
+            }),
+            ("blob_matching.max_distance", Rule::NonNegative, |c| {
+                c.blob_matching.max_distance = -0.3
+            }),
             ("pair.sweep.step_deg", Rule::FinitePositive, |c| {
                 c.pair.sweep.as_mut().unwrap().step_deg = 0.0
             }),
