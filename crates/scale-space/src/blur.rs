@@ -67,6 +67,97 @@ pub fn gaussian_blur(src: &Image, kernel: &GaussianKernel, tmp: &mut Image, dst:
     vertical(tmp, kernel, dst);
 }
 
+/// [`gaussian_blur`] of `src` kept only every `step` pixels along both axes: `dst(m, n)` is
+/// the blurred image at `(step * m, step * n)`, for `m = 0..=(width - 1) / step` and `n =
+/// 0..=(height - 1) / step`. Each kept pixel gets exactly the value [`gaussian_blur`] gives it
+/// (the same operations in the same order), at about `1 / step` of the horizontal pass's work
+/// and `1 / step^2` of the vertical pass's: the seed of a scale space whose first octave is
+/// coarser than the input (`delta_min` of 2) needs only those pixels.
+///
+/// # Panics
+/// When `step` is 0.
+pub fn gaussian_blur_sampled(
+    src: &Image,
+    kernel: &GaussianKernel,
+    step: usize,
+    tmp: &mut Image,
+    dst: &mut Image,
+) {
+    assert!(step > 0, "sampling step 0");
+    let (w, h) = (src.width, src.height);
+    if w == 0 || h == 0 {
+        tmp.reshape(0, 0);
+        dst.reshape(0, 0);
+        return;
+    }
+    let (ws, hs) = ((w - 1) / step + 1, (h - 1) / step + 1);
+    // Horizontal: every row, the kept columns only.
+    tmp.reshape(ws, h);
+    let r = kernel.radius();
+    let taps = &kernel.taps;
+    tmp.data
+        .par_chunks_mut(ws * ROWS_PER_TASK)
+        .enumerate()
+        .for_each_init(
+            || (vec![0.0f32; w + 2 * r], Vec::new()),
+            |(padded, phases): &mut (Vec<f32>, Vec<Vec<f32>>), (chunk, out_rows)| {
+                for (i, out) in out_rows.chunks_exact_mut(ws).enumerate() {
+                    pad_row(src.row(chunk * ROWS_PER_TASK + i), r, padded);
+                    // The padded row split by index modulo `step`: padded sample `step * j + p`
+                    // is `phases[p][j]`, so that kept column `m`'s taps at `step * m + c` read
+                    // one phase along `m`, which vectorises like the full pass.
+                    phases.resize_with(step, Vec::new);
+                    for (p, phase) in phases.iter_mut().enumerate() {
+                        phase.clear();
+                        phase.extend(padded.iter().skip(p).step_by(step));
+                    }
+                    let at = |c: usize| &phases[c % step][c / step..][..ws];
+                    for (o, v) in out.iter_mut().zip(at(r)) {
+                        *o = taps[0] * v;
+                    }
+                    for (k, &t) in taps.iter().enumerate().skip(1) {
+                        for ((o, a), b) in out.iter_mut().zip(at(r - k)).zip(at(r + k)) {
+                            *o += t * (a + b);
+                        }
+                    }
+                }
+            },
+        );
+    // Vertical: the kept rows only, as `vertical` computes them.
+    dst.reshape(ws, hs);
+    let tmp = &*tmp;
+    dst.data
+        .par_chunks_mut(ws)
+        .enumerate()
+        .with_min_len(ROWS_PER_TASK)
+        .for_each(|(n, out)| {
+            let y = (n * step) as isize;
+            for (o, s) in out.iter_mut().zip(tmp.row(y as usize)) {
+                *o = taps[0] * s;
+            }
+            for (k, &t) in taps.iter().enumerate().skip(1) {
+                let up = tmp.row(mirror(y - k as isize, h));
+                let down = tmp.row(mirror(y + k as isize, h));
+                for ((o, a), b) in out.iter_mut().zip(up).zip(down) {
+                    *o += t * (a + b);
+                }
+            }
+        });
+}
+
+/// `row` copied into `padded` (resized to `row.len() + 2 r`) between `r` mirrored samples on
+/// each side.
+fn pad_row(row: &[f32], r: usize, padded: &mut Vec<f32>) {
+    let w = row.len();
+    padded.resize(w + 2 * r, 0.0);
+    // Copy the row, then mirror only the 2r border samples.
+    padded[r..r + w].copy_from_slice(row);
+    for k in 1..=r {
+        padded[r - k] = row[mirror(-(k as isize), w)];
+        padded[r + w - 1 + k] = row[mirror((w - 1 + k) as isize, w)];
+    }
+}
+
 /// Horizontal pass: each row is copied with mirrored padding, then convolved.
 fn horizontal(src: &Image, kernel: &GaussianKernel, dst: &mut Image) {
     let w = src.width;
@@ -78,15 +169,8 @@ fn horizontal(src: &Image, kernel: &GaussianKernel, dst: &mut Image) {
         .for_each_init(
             || vec![0.0f32; w + 2 * r],
             |padded, (chunk, out_rows)| {
-                padded.resize(w + 2 * r, 0.0);
                 for (i, out) in out_rows.chunks_exact_mut(w).enumerate() {
-                    let row = src.row(chunk * ROWS_PER_TASK + i);
-                    // Copy the row, then mirror only the 2r border samples.
-                    padded[r..r + w].copy_from_slice(row);
-                    for k in 1..=r {
-                        padded[r - k] = row[mirror(-(k as isize), w)];
-                        padded[r + w - 1 + k] = row[mirror((w - 1 + k) as isize, w)];
-                    }
+                    pad_row(src.row(chunk * ROWS_PER_TASK + i), r, padded);
                     // Centre tap, then symmetric pairs: the inner loop over x vectorises.
                     for (x, o) in out.iter_mut().enumerate() {
                         *o = taps[0] * padded[x + r];
@@ -152,6 +236,40 @@ mod tests {
             .map(|(i, t)| 2.0 * t * (i * i) as f32)
             .sum();
         assert!((var - 4.0).abs() < 0.01, "variance {var}");
+    }
+
+    #[test]
+    fn the_sampled_blur_is_the_blur_at_the_kept_pixels_exactly() {
+        // Odd and even sizes, sides shorter than the kernel, steps 1 to 3.
+        for (w, h) in [(37, 23), (64, 41), (5, 3), (1, 9), (20, 1)] {
+            let src = Image {
+                width: w,
+                height: h,
+                data: (0..w * h)
+                    .map(|i| ((i * 7919) % 101) as f32 / 100.0)
+                    .collect(),
+            };
+            for sigma in [0.6, 1.52, 3.0] {
+                let kernel = GaussianKernel::new(sigma);
+                let (mut tmp, mut full, mut kept) =
+                    (Image::default(), Image::default(), Image::default());
+                gaussian_blur(&src, &kernel, &mut tmp, &mut full);
+                for step in 1..=3 {
+                    gaussian_blur_sampled(&src, &kernel, step, &mut tmp, &mut kept);
+                    let (ws, hs) = ((w - 1) / step + 1, (h - 1) / step + 1);
+                    assert_eq!((kept.width, kept.height), (ws, hs));
+                    for n in 0..hs {
+                        for m in 0..ws {
+                            assert_eq!(
+                                kept.at(m, n).to_bits(),
+                                full.at(step * m, step * n).to_bits(),
+                                "{w} x {h}, sigma {sigma}, step {step}, at ({m}, {n})"
+                            );
+                        }
+                    }
+                }
+            }
+        }
     }
 
     #[test]

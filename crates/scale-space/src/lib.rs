@@ -20,7 +20,7 @@ mod detect;
 mod image;
 mod pyramid;
 
-pub use blur::{GaussianKernel, gaussian_blur};
+pub use blur::{GaussianKernel, gaussian_blur, gaussian_blur_sampled};
 pub use image::{
     CropRect, Image, IntensityMapping, intensity_image, intensity_image_in, known_bounding_box,
 };

@@ -2,7 +2,7 @@
 
 use rayon::prelude::*;
 
-use crate::blur::{GaussianKernel, gaussian_blur};
+use crate::blur::{GaussianKernel, gaussian_blur, gaussian_blur_sampled};
 use crate::{Error, Image, ScaleSpaceConfig};
 
 /// One octave: `n_spo + 3` Gaussian images and `n_spo + 2` differences, all sampled every
@@ -77,6 +77,18 @@ impl ScaleSpace {
                     resample(image, config.delta_min, &mut seed);
                     let kernel = GaussianKernel::new(extra.sqrt() / config.delta_min);
                     gaussian_blur(&seed, &kernel, &mut self.tmp, &mut octave.gaussians[0]);
+                } else if config.delta_min.fract() == 0.0 {
+                    // Coarser than the input by a whole step (the default 2): blur to
+                    // sigma_min, so the seed does not alias, computing only the samples kept
+                    // (the same values as blurring everything and sampling: bilinear
+                    // sampling at whole pixels reads them unchanged).
+                    gaussian_blur_sampled(
+                        image,
+                        &GaussianKernel::new(extra.sqrt()),
+                        config.delta_min as usize,
+                        &mut self.tmp,
+                        &mut octave.gaussians[0],
+                    );
                 } else {
                     // Coarser than the input: blur to sigma_min first, then sample, so the
                     // seed does not alias.
@@ -198,5 +210,23 @@ mod tests {
         };
         // Short side 5 -> 9 (delta 0.5), 5, 3, then 2 < 3.
         assert_eq!(octave_count(9, 5, &config), 3);
+    }
+
+    /// The seed of `delta_min` 2 blurs only the samples kept ([`gaussian_blur_sampled`]),
+    /// which is the blur then [`resample`] only if resampling at whole pixels reads them
+    /// unchanged.
+    #[test]
+    fn resampling_by_two_reads_whole_pixels_unchanged() {
+        for (w, h) in [(9, 5), (10, 6), (1, 4)] {
+            let img = Image {
+                width: w,
+                height: h,
+                data: (0..w * h).map(|i| (i as f32 * 0.37).sin()).collect(),
+            };
+            let (mut sampled, mut kept) = (Image::default(), Image::default());
+            resample(&img, 2.0, &mut sampled);
+            decimate(&img, &mut kept);
+            assert_eq!(sampled, kept, "{w} x {h}");
+        }
     }
 }
