@@ -187,6 +187,8 @@ pub struct BlobScratch {
     tmp: Vec<u8>,
     labels: Vec<u32>,
     labeler: Labeler,
+    /// Per label (index 0 the background), whether the moments skip it.
+    skip: Vec<bool>,
     acc: Vec<Accumulator>,
 }
 
@@ -248,14 +250,11 @@ impl Blobs {
         let grid = if (w, h) == (grid.width(), grid.height()) {
             grid
         } else {
-            let cells: Vec<u8> = grid
-                .cells()
-                .chunks_exact(grid.width())
-                .skip(y0)
-                .take(h)
-                .flat_map(|row| &row[x0..x0 + w])
-                .copied()
-                .collect();
+            // Row by row as slices (a copy per row, not per cell).
+            let mut cells = Vec::with_capacity(w * h);
+            for row in grid.cells().chunks_exact(grid.width()).skip(y0).take(h) {
+                cells.extend_from_slice(&row[x0..x0 + w]);
+            }
             let Ok(g) = OccupancyGrid::from_cells(w, h, grid.resolution(), grid.origin(), cells)
             else {
                 return;
@@ -281,10 +280,27 @@ impl Blobs {
         else {
             return;
         };
+        // Not-free components that touch the window's border are the unknown surround, which
+        // is dropped below: often most of the window, so they are not accumulated at all.
+        scratch.skip.clear();
+        scratch.skip.resize(n + 1, false);
+        scratch.skip[0] = true;
+        if c.mask == MaskKind::NotFreeIslands {
+            let labels = &scratch.labels;
+            let border = labels[..w]
+                .iter()
+                .chain(&labels[(h - 1) * w..])
+                .chain(labels.iter().step_by(w))
+                .chain(labels[w - 1..].iter().step_by(w));
+            for &l in border {
+                scratch.skip[l as usize] = true;
+            }
+        }
         accumulate(
             &scratch.labels,
             &scratch.mask,
             n,
+            &scratch.skip,
             grid,
             (x0, y0),
             &mut scratch.acc,

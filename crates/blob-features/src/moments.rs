@@ -187,15 +187,19 @@ fn log_scale(h: f64) -> f64 {
 /// exactly where `mask` is) into `acc` (resized to `n`). `grid` supplies the unknown cells for
 /// the contact measure; it must have the labels' size. `origin` is added to every pixel's
 /// coordinates (the labels may cover a window of a larger grid), so positions come out in the
-/// larger grid's frame, computed exactly as if it had been labelled whole.
+/// larger grid's frame, computed exactly as if it had been labelled whole. Components `l` with
+/// `skip[l]` (`skip` has `n + 1` entries, `skip[0]` for the background, which must be set) are
+/// not accumulated and keep an empty accumulator.
 pub(crate) fn accumulate(
     labels: &[u32],
     mask: &[u8],
     n: usize,
+    skip: &[bool],
     grid: &OccupancyGrid,
     origin: (usize, usize),
     acc: &mut Vec<Accumulator>,
 ) {
+    debug_assert_eq!(skip.len(), n + 1);
     let (w, h) = (grid.width(), grid.height());
     acc.clear();
     acc.resize(n, Accumulator::default());
@@ -217,7 +221,7 @@ pub(crate) fn accumulate(
             }
             let l = row[x];
             x += 1;
-            if l == 0 {
+            if skip[l as usize] {
                 continue;
             }
             let x = x - 1;
