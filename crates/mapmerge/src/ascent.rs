@@ -103,22 +103,30 @@ pub fn wall_thickness(grid: &OccupancyGrid) -> f64 {
 /// of 20 %"), so two maps of alike sensors score alike. 0 for a map without occupied cells.
 pub fn lone_wall_share(grid: &OccupancyGrid) -> f64 {
     let (w, h) = (grid.width(), grid.height());
-    let occupied = |x: usize, y: usize| grid.state(x, y) == CellState::Occupied;
+    let cells = grid.cells();
+    let occupied = |c: &u8| OccupancyGrid::classify(*c) == CellState::Occupied;
+    let row = |y: usize| &cells[y * w..][..w];
     let (mut walls, mut lone) = (0usize, 0usize);
+    // Row slices: the scan of the (mostly not occupied) cells is one test a cell, and an
+    // occupied cell's neighbours are three short slices.
     for y in 0..h {
-        for x in 0..w {
-            if !occupied(x, y) {
+        let (here, up, down) = (
+            row(y),
+            y.checked_sub(1).map(row),
+            (y + 1 < h).then(|| row(y + 1)),
+        );
+        for (x, c) in here.iter().enumerate() {
+            if !occupied(c) {
                 continue;
             }
             walls += 1;
-            let (x0, x1, y0, y1) = (
-                x.saturating_sub(1),
-                (x + 1).min(w - 1),
-                y.saturating_sub(1),
-                (y + 1).min(h - 1),
-            );
-            let neighbour =
-                (y0..=y1).any(|v| (x0..=x1).any(|u| (u, v) != (x, y) && occupied(u, v)));
+            let around = x.saturating_sub(1)..=(x + 1).min(w - 1);
+            let neighbour = (x > 0 && occupied(&here[x - 1]))
+                || (x + 1 < w && occupied(&here[x + 1]))
+                || [up, down]
+                    .into_iter()
+                    .flatten()
+                    .any(|r| r[around.clone()].iter().any(occupied));
             lone += usize::from(!neighbour);
         }
     }
@@ -259,6 +267,54 @@ mod tests {
         // No occupied cell: 0.
         let free = OccupancyGrid::from_cells(4, 4, 0.05, Pose2::default(), vec![0; 16]).unwrap();
         assert_eq!(lone_wall_share(&free), 0.0);
+    }
+
+    /// The row-slice scan counts as the plain definition does, at every border and size.
+    #[test]
+    fn lone_wall_share_is_its_definition_on_random_grids() {
+        let definition = |g: &OccupancyGrid| {
+            let (w, h) = (g.width() as i64, g.height() as i64);
+            let occ = |x: i64, y: i64| {
+                x >= 0
+                    && y >= 0
+                    && x < w
+                    && y < h
+                    && g.state(x as usize, y as usize) == CellState::Occupied
+            };
+            let (mut walls, mut lone) = (0, 0);
+            for y in 0..h {
+                for x in 0..w {
+                    if occ(x, y) {
+                        walls += 1;
+                        let n = (-1..=1)
+                            .flat_map(|dy| (-1..=1).map(move |dx| (dx, dy)))
+                            .filter(|&d| d != (0, 0))
+                            .any(|(dx, dy)| occ(x + dx, y + dy));
+                        lone += usize::from(!n);
+                    }
+                }
+            }
+            if walls == 0 {
+                0.0
+            } else {
+                lone as f64 / walls as f64
+            }
+        };
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        for (w, h) in [(1, 1), (1, 7), (7, 1), (2, 2), (13, 9), (40, 31)] {
+            for _ in 0..20 {
+                let cells: Vec<u8> = (0..w * h)
+                    .map(|_| {
+                        seed ^= seed << 13;
+                        seed ^= seed >> 7;
+                        seed ^= seed << 17;
+                        [0, 100, 100, UNKNOWN, 0, 70][(seed % 6) as usize]
+                    })
+                    .collect();
+                let g = OccupancyGrid::from_cells(w, h, 0.05, Pose2::default(), cells).unwrap();
+                assert_eq!(lone_wall_share(&g), definition(&g), "{w} x {h}");
+            }
+        }
     }
 
     #[test]
