@@ -130,19 +130,25 @@ pub fn gaussian_blur_sampled(
         .par_chunks_mut(ws)
         .enumerate()
         .with_min_len(ROWS_PER_TASK)
-        .for_each(|(n, out)| {
-            let y = (n * step) as isize;
-            for (o, s) in out.iter_mut().zip(tmp.row(y as usize)) {
-                *o = taps[0] * s;
-            }
-            for (k, &t) in taps.iter().enumerate().skip(1) {
-                let up = tmp.row(mirror(y - k as isize, h));
-                let down = tmp.row(mirror(y + k as isize, h));
-                for ((o, a), b) in out.iter_mut().zip(up).zip(down) {
-                    *o += t * (a + b);
-                }
-            }
-        });
+        .for_each(|(n, out)| vertical_row(tmp, taps, n * step, out));
+}
+
+/// Row `y` of the vertical pass of `src` with the half kernel `taps`, into `out`: row `y`
+/// accumulates whole input rows `y ± k`, which vectorises over `x` and reads memory in order
+/// (no transpose needed). [`vertical`] and [`gaussian_blur_sampled`] share it, so a row gets
+/// the same value from both.
+fn vertical_row(src: &Image, taps: &[f32], y: usize, out: &mut [f32]) {
+    let (h, y) = (src.height, y as isize);
+    for (o, s) in out.iter_mut().zip(src.row(y as usize)) {
+        *o = taps[0] * s;
+    }
+    for (k, &t) in taps.iter().enumerate().skip(1) {
+        let up = src.row(mirror(y - k as isize, h));
+        let down = src.row(mirror(y + k as isize, h));
+        for ((o, a), b) in out.iter_mut().zip(up).zip(down) {
+            *o += t * (a + b);
+        }
+    }
 }
 
 /// `row` copied into `padded` (resized to `row.len() + 2 r`) between `r` mirrored samples on
@@ -187,27 +193,15 @@ fn horizontal(src: &Image, kernel: &GaussianKernel, dst: &mut Image) {
         );
 }
 
-/// Vertical pass: output row `y` accumulates whole input rows `y ± k`, which vectorises over
-/// `x` and reads memory in order (no transpose needed).
+/// Vertical pass: every row by [`vertical_row`].
 fn vertical(src: &Image, kernel: &GaussianKernel, dst: &mut Image) {
-    let (w, h) = (src.width, src.height);
-    let taps = &kernel.taps;
+    let w = src.width;
     dst.data
         .par_chunks_mut(w * ROWS_PER_TASK)
         .enumerate()
         .for_each(|(chunk, out_rows)| {
             for (i, out) in out_rows.chunks_exact_mut(w).enumerate() {
-                let y = (chunk * ROWS_PER_TASK + i) as isize;
-                for (o, s) in out.iter_mut().zip(src.row(y as usize)) {
-                    *o = taps[0] * s;
-                }
-                for (k, &t) in taps.iter().enumerate().skip(1) {
-                    let up = src.row(mirror(y - k as isize, h));
-                    let down = src.row(mirror(y + k as isize, h));
-                    for ((o, a), b) in out.iter_mut().zip(up).zip(down) {
-                        *o += t * (a + b);
-                    }
-                }
+                vertical_row(src, &kernel.taps, chunk * ROWS_PER_TASK + i, out);
             }
         });
 }
