@@ -57,22 +57,15 @@ fn mirror(i: isize, n: usize) -> usize {
 /// `tmp` as the intermediate image. Every output pixel is computed by the same sequence of
 /// operations whatever the thread count, so the result is deterministic.
 pub fn gaussian_blur(src: &Image, kernel: &GaussianKernel, tmp: &mut Image, dst: &mut Image) {
-    let (w, h) = (src.width, src.height);
-    tmp.reshape(w, h);
-    dst.reshape(w, h);
-    if w == 0 || h == 0 {
-        return;
-    }
-    horizontal(src, kernel, tmp);
-    vertical(tmp, kernel, dst);
+    gaussian_blur_sampled(src, kernel, 1, tmp, dst);
 }
 
 /// [`gaussian_blur`] of `src` kept only every `step` pixels along both axes: `dst(m, n)` is
 /// the blurred image at `(step * m, step * n)`, for `m = 0..=(width - 1) / step` and `n =
 /// 0..=(height - 1) / step`. Each kept pixel gets exactly the value [`gaussian_blur`] gives it
-/// (the same operations in the same order), at about `1 / step` of the horizontal pass's work
-/// and `1 / step^2` of the vertical pass's: the seed of a scale space whose first octave is
-/// coarser than the input (`delta_min` of 2) needs only those pixels.
+/// (one code path: [`gaussian_blur`] is this with `step` 1), at about `1 / step` of the
+/// horizontal pass's work and `1 / step^2` of the vertical pass's: the seed of a scale space
+/// whose first octave is coarser than the input (`delta_min` of 2) needs only those pixels.
 ///
 /// # Panics
 /// When `step` is 0.
@@ -85,12 +78,14 @@ pub fn gaussian_blur_sampled(
 ) {
     assert!(step > 0, "sampling step 0");
     let (w, h) = (src.width, src.height);
+    // Samples kept of `n`: `0, step, ...` up to `n - 1`.
+    let kept = |n: usize| if n == 0 { 0 } else { (n - 1) / step + 1 };
+    let (ws, hs) = (kept(w), kept(h));
     if w == 0 || h == 0 {
-        tmp.reshape(0, 0);
-        dst.reshape(0, 0);
+        tmp.reshape(ws, h);
+        dst.reshape(ws, hs);
         return;
     }
-    let (ws, hs) = ((w - 1) / step + 1, (h - 1) / step + 1);
     // Horizontal: every row, the kept columns only.
     tmp.reshape(ws, h);
     let r = kernel.radius();
@@ -103,15 +98,25 @@ pub fn gaussian_blur_sampled(
             |(padded, phases): &mut (Vec<f32>, Vec<Vec<f32>>), (chunk, out_rows)| {
                 for (i, out) in out_rows.chunks_exact_mut(ws).enumerate() {
                     pad_row(src.row(chunk * ROWS_PER_TASK + i), r, padded);
-                    // The padded row split by index modulo `step`: padded sample `step * j + p`
-                    // is `phases[p][j]`, so that kept column `m`'s taps at `step * m + c` read
-                    // one phase along `m`, which vectorises like the full pass.
-                    phases.resize_with(step, Vec::new);
-                    for (p, phase) in phases.iter_mut().enumerate() {
-                        phase.clear();
-                        phase.extend(padded.iter().skip(p).step_by(step));
+                    // Sampled, the padded row split by index modulo `step`: padded sample
+                    // `step * j + p` is `phases[p][j]`, so that kept column `m`'s taps at
+                    // `step * m + c` read one phase along `m`, which vectorises as the whole
+                    // row does.
+                    if step > 1 {
+                        phases.resize_with(step, Vec::new);
+                        for (p, phase) in phases.iter_mut().enumerate() {
+                            phase.clear();
+                            phase.extend(padded.iter().skip(p).step_by(step));
+                        }
                     }
-                    let at = |c: usize| &phases[c % step][c / step..][..ws];
+                    let at = |c: usize| -> &[f32] {
+                        if step == 1 {
+                            &padded[c..][..ws]
+                        } else {
+                            &phases[c % step][c / step..][..ws]
+                        }
+                    };
+                    // Centre tap, then symmetric pairs.
                     for (o, v) in out.iter_mut().zip(at(r)) {
                         *o = taps[0] * v;
                     }
@@ -123,7 +128,7 @@ pub fn gaussian_blur_sampled(
                 }
             },
         );
-    // Vertical: the kept rows only, as `vertical` computes them.
+    // Vertical: the kept rows only.
     dst.reshape(ws, hs);
     let tmp = &*tmp;
     dst.data
@@ -135,8 +140,7 @@ pub fn gaussian_blur_sampled(
 
 /// Row `y` of the vertical pass of `src` with the half kernel `taps`, into `out`: row `y`
 /// accumulates whole input rows `y ± k`, which vectorises over `x` and reads memory in order
-/// (no transpose needed). [`vertical`] and [`gaussian_blur_sampled`] share it, so a row gets
-/// the same value from both.
+/// (no transpose needed).
 fn vertical_row(src: &Image, taps: &[f32], y: usize, out: &mut [f32]) {
     let (h, y) = (src.height, y as isize);
     for (o, s) in out.iter_mut().zip(src.row(y as usize)) {
@@ -162,48 +166,6 @@ fn pad_row(row: &[f32], r: usize, padded: &mut Vec<f32>) {
         padded[r - k] = row[mirror(-(k as isize), w)];
         padded[r + w - 1 + k] = row[mirror((w - 1 + k) as isize, w)];
     }
-}
-
-/// Horizontal pass: each row is copied with mirrored padding, then convolved.
-fn horizontal(src: &Image, kernel: &GaussianKernel, dst: &mut Image) {
-    let w = src.width;
-    let r = kernel.radius();
-    let taps = &kernel.taps;
-    dst.data
-        .par_chunks_mut(w * ROWS_PER_TASK)
-        .enumerate()
-        .for_each_init(
-            || vec![0.0f32; w + 2 * r],
-            |padded, (chunk, out_rows)| {
-                for (i, out) in out_rows.chunks_exact_mut(w).enumerate() {
-                    pad_row(src.row(chunk * ROWS_PER_TASK + i), r, padded);
-                    // Centre tap, then symmetric pairs: the inner loop over x vectorises.
-                    for (x, o) in out.iter_mut().enumerate() {
-                        *o = taps[0] * padded[x + r];
-                    }
-                    for (k, &t) in taps.iter().enumerate().skip(1) {
-                        let left = &padded[r - k..r - k + w];
-                        let right = &padded[r + k..r + k + w];
-                        for ((o, a), b) in out.iter_mut().zip(left).zip(right) {
-                            *o += t * (a + b);
-                        }
-                    }
-                }
-            },
-        );
-}
-
-/// Vertical pass: every row by [`vertical_row`].
-fn vertical(src: &Image, kernel: &GaussianKernel, dst: &mut Image) {
-    let w = src.width;
-    dst.data
-        .par_chunks_mut(w * ROWS_PER_TASK)
-        .enumerate()
-        .for_each(|(chunk, out_rows)| {
-            for (i, out) in out_rows.chunks_exact_mut(w).enumerate() {
-                vertical_row(src, &kernel.taps, chunk * ROWS_PER_TASK + i, out);
-            }
-        });
 }
 
 #[cfg(test)]
