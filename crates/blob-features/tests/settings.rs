@@ -50,35 +50,20 @@ fn nan_drop_fraction_is_refused() {
 
 #[test]
 fn negative_or_nan_matching_bars_are_refused() {
+    // Each bar at each refused value, the other at its default.
+    let with = |name: &str, value: f64| {
+        let mut c = MatchConfig::default();
+        *match name {
+            "ratio" => &mut c.ratio,
+            _ => &mut c.max_distance,
+        } = value;
+        c
+    };
     for (name, config) in [
-        (
-            "ratio",
-            MatchConfig {
-                ratio: -0.8,
-                ..MatchConfig::default()
-            },
-        ),
-        (
-            "ratio",
-            MatchConfig {
-                ratio: f64::NAN,
-                ..MatchConfig::default()
-            },
-        ),
-        (
-            "max_distance",
-            MatchConfig {
-                max_distance: -0.3,
-                ..MatchConfig::default()
-            },
-        ),
-        (
-            "max_distance",
-            MatchConfig {
-                max_distance: f64::NAN,
-                ..MatchConfig::default()
-            },
-        ),
+        ("ratio", with("ratio", -0.8)),
+        ("ratio", with("ratio", f64::NAN)),
+        ("max_distance", with("max_distance", -0.3)),
+        ("max_distance", with("max_distance", f64::NAN)),
     ] {
         let err = BlobCorrespondences::new(BlobConfig::default(), config).unwrap_err();
         assert!(
