@@ -888,9 +888,20 @@ pub fn register_with(
     config: &PairConfig,
 ) -> Result<Registration, Error> {
     config.validate()?;
+    Ok(register_framed(a, b, sources, config))
+}
+
+/// [`register_with`] for settings already checked: each map cut to its frame
+/// ([`PairConfig::frame`]), registered, and the answer given in the maps' own pixels.
+fn register_framed(
+    a: &OccupancyGrid,
+    b: &OccupancyGrid,
+    sources: &[&(dyn CorrespondenceSource + Sync)],
+    config: &PairConfig,
+) -> Registration {
     let (Some((fa, oa)), Some((fb, ob))) = rayon::join(|| config.frame(a), || config.frame(b))
     else {
-        return Ok(register_as_given(a, b, sources, config));
+        return register_as_given(a, b, sources, config);
     };
     let mut r = register_as_given(&fa, &fb, sources, config);
     for c in r.accepted.iter_mut().chain(r.candidates.iter_mut()) {
@@ -899,7 +910,7 @@ pub fn register_with(
     for m in &mut r.matches {
         (m.a, m.b) = (m.a + oa, m.b + ob);
     }
-    Ok(r)
+    r
 }
 
 /// [`register_with`] on the maps as given (no frames).
@@ -1549,7 +1560,8 @@ pub fn register(
         Method::Blobs => vec![&blobs],
         Method::Hybrid => vec![&sift, &blobs],
     };
-    register_with(a, b, &sources, &config.pair)
+    // `config.validate` checked the pair settings too (under their `pair.` paths).
+    Ok(register_framed(a, b, &sources, &config.pair))
 }
 
 #[cfg(test)]

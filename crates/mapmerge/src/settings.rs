@@ -837,6 +837,12 @@ mod tests {
             matches!(&err, Error::Setting { name, .. } if name == "pair.verify.min_wall_lift"),
             "{err}"
         );
+        // `register_with` takes the pair settings alone and checks them itself.
+        let err = crate::register_with(&a, &a, &[], &c.pair).unwrap_err();
+        assert!(
+            matches!(&err, Error::Setting { name, .. } if name == "verify.min_wall_lift"),
+            "{err}"
+        );
         let team = crate::team::merge_team(
             &[&a, &a],
             &[1.0, 1.0],
