@@ -15,7 +15,7 @@
 
 use std::f64::consts::PI;
 
-use grid_core::{CellState, DVec2, Rigid2};
+use grid_core::{CellState, DVec2, OccupancyGrid, Rigid2};
 use rayon::prelude::*;
 use rustfft::FftPlanner;
 use rustfft::num_complex::Complex32;
@@ -128,15 +128,24 @@ fn coarse_field(
     let mut occ = vec![0u32; w * h];
     let mut free = vec![0u32; w * h];
     let g = a.grid;
-    for y in 0..g.height() {
-        for x in 0..g.width() {
-            let (cx, cy) = ((x as f64 / scale) as usize, (y as f64 / scale) as usize);
-            if cx >= w || cy >= h {
+    // Each pixel's coarse cell is `(x / scale, y / scale)` truncated: the column's part is
+    // worked out once per column, the row's once per row.
+    let columns: Vec<usize> = (0..g.width())
+        .map(|x| (x as f64 / scale) as usize)
+        .collect();
+    for (y, row) in g.cells().chunks_exact(g.width().max(1)).enumerate() {
+        let cy = (y as f64 / scale) as usize;
+        if cy >= h {
+            continue;
+        }
+        let (occ_row, free_row) = (&mut occ[cy * w..][..w], &mut free[cy * w..][..w]);
+        for (&cell, &cx) in row.iter().zip(&columns) {
+            if cx >= w {
                 continue;
             }
-            match g.state(x, y) {
-                CellState::Occupied => occ[cy * w + cx] += 1,
-                CellState::Free => free[cy * w + cx] += 1,
+            match OccupancyGrid::classify(cell) {
+                CellState::Occupied => occ_row[cx] += 1,
+                CellState::Free => free_row[cx] += 1,
                 CellState::Unknown => {}
             }
         }
@@ -1275,6 +1284,78 @@ mod tests {
                 assert!(top > 1e3, "{thetas:?}: an empty correlation");
                 for (p, q) in paired.iter().zip(&alone) {
                     assert!((p - q).norm() <= 1e-5 * top, "{thetas:?}: {p} against {q}");
+                }
+            }
+        }
+    }
+
+    /// The row-by-row count puts each pixel in the cell of its own coordinates divided by
+    /// the scale, as a pixel-by-pixel count does, with fields cut short of the grid too.
+    #[test]
+    fn the_coarse_field_counts_each_pixel_in_its_cell() {
+        let definition = |g: &OccupancyGrid, scale: f64, w: usize, h: usize| {
+            let (mut occ, mut free) = (vec![0u32; w * h], vec![0u32; w * h]);
+            for y in 0..g.height() {
+                for x in 0..g.width() {
+                    let (cx, cy) = ((x as f64 / scale) as usize, (y as f64 / scale) as usize);
+                    if cx < w && cy < h {
+                        match g.state(x, y) {
+                            CellState::Occupied => occ[cy * w + cx] += 1,
+                            CellState::Free => free[cy * w + cx] += 1,
+                            CellState::Unknown => {}
+                        }
+                    }
+                }
+            }
+            (occ, free)
+        };
+        let vc = VerifyConfig::default();
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        for (gw, gh) in [(1, 1), (1, 9), (9, 1), (17, 12), (40, 33)] {
+            let cells: Vec<u8> = (0..gw * gh)
+                .map(|_| {
+                    seed ^= seed << 13;
+                    seed ^= seed >> 7;
+                    seed ^= seed << 17;
+                    [0, 100, grid_core::UNKNOWN, 0, 70, 30][(seed % 6) as usize]
+                })
+                .collect();
+            let g = OccupancyGrid::from_cells(gw, gh, 0.05, Default::default(), cells).unwrap();
+            let pg = PreparedMap::new(&g, &vc);
+            for scale in [1.0, 2.5, 3.0, 4.7] {
+                let full = (
+                    (gw as f64 / scale).ceil() as usize + 1,
+                    (gh as f64 / scale).ceil() as usize + 1,
+                );
+                for (w, h) in [full, (full.0.div_ceil(2), full.1.div_ceil(2))] {
+                    let (occ, free) = definition(&g, scale, w, h);
+                    // The field and mask of those counts, by the rule of `coarse_field`.
+                    let (field, known) = coarse_field(&pg, scale, w, h, 0.5);
+                    for i in 0..w * h {
+                        let (x, y) = (i % w, i / w);
+                        let wall_next =
+                            [(-1i64, 0i64), (1, 0), (0, -1), (0, 1)]
+                                .iter()
+                                .any(|&(dx, dy)| {
+                                    let (nx, ny) = (x as i64 + dx, y as i64 + dy);
+                                    nx >= 0
+                                        && ny >= 0
+                                        && (nx as usize) < w
+                                        && (ny as usize) < h
+                                        && occ[ny as usize * w + nx as usize] > 0
+                                });
+                        let expected = if occ[i] > 0 {
+                            1.0
+                        } else if wall_next {
+                            0.5
+                        } else if free[i] > 0 {
+                            -0.5
+                        } else {
+                            0.0
+                        };
+                        assert_eq!(field[i], expected, "{gw} x {gh} at scale {scale}, cell {i}");
+                        assert_eq!(known[i], occ[i] > 0 || free[i] > 0 || wall_next);
+                    }
                 }
             }
         }
