@@ -231,6 +231,10 @@ pub struct EvalArgs {
     /// (`mapmerge::TurnScan::max_speckle_ratio`; default: the library's).
     #[arg(long, value_name = "RATIO", value_parser = non_negative::<f64>)]
     turn_scan_speckle_ratio: Option<f64>,
+    /// Do not scan the angle of an answer that the bars for clean maps would decline unless
+    /// the lever and speckle gates allow it (`mapmerge::TurnScan::rescue_misfits` false).
+    #[arg(long)]
+    no_turn_scan_rescue: bool,
     /// Scan the angle also after the Manhattan angle was taken
     /// (`mapmerge::TurnScan::keep_manhattan_angle` false).
     #[arg(long)]
@@ -1027,6 +1031,9 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
         (args.turn_scan_speckle_ratio, config.pair.turn_scan.as_mut())
     {
         scan.max_speckle_ratio = ratio;
+    }
+    if let (true, Some(scan)) = (args.no_turn_scan_rescue, config.pair.turn_scan.as_mut()) {
+        scan.rescue_misfits = false;
     }
     if let (true, Some(scan)) = (
         args.turn_scan_after_manhattan,
