@@ -69,6 +69,17 @@ fn nothing_shared(name: &str, seed: u64) -> (mapsim::CropPair, String) {
     (pair, reason)
 }
 
+/// Fixture floor `name` cut in two, the parts sharing 30 % of their extent (case `seed` of
+/// `cargo xtask eval --suites crops`' 30 % rows), and its answer with the default settings.
+fn registered_crop(name: &str, seed: u64) -> (mapsim::CropPair, mapmerge::Candidate) {
+    let pair = mapsim::crop_pair(&floor(name), &mapsim::CropConfig::default(), seed).unwrap();
+    let r = register(&pair.a, &pair.b, &RegisterConfig::default()).unwrap();
+    let c = r
+        .accepted
+        .unwrap_or_else(|| panic!("{name}, case {seed}: declined: {:?}", r.reason));
+    (pair, c)
+}
+
 fn assert_registered(name: &str, degrees: f64) {
     let (a, b, truth) = crops(name, degrees, 30);
     let r = register(&a, &b, &RegisterConfig::default()).unwrap();
@@ -129,12 +140,7 @@ fn a_floor_cut_in_two_with_nothing_shared_is_declined_for_walls_in_free_space() 
 /// needs otherwise, the pair was declined.
 #[test]
 fn floor_parts_that_share_a_tenth_of_their_known_cells_are_registered_when_their_walls_agree() {
-    let floor = floor("uos_avz");
-    let pair = mapsim::crop_pair(&floor, &mapsim::CropConfig::default(), 8_004_000).unwrap();
-    let r = register(&pair.a, &pair.b, &RegisterConfig::default()).unwrap();
-    let c = r
-        .accepted
-        .unwrap_or_else(|| panic!("declined: {:?}", r.reason));
+    let (pair, c) = registered_crop("uos_avz", 8_004_000);
     let v = c.verification;
     assert!((0.1..0.15).contains(&v.overlap_fraction), "{v:?}");
     let disp = displacement_error(&pair.b, &c.transform, &pair.truth).unwrap();
@@ -182,12 +188,7 @@ fn a_floor_with_repeated_rooms_cut_in_two_with_nothing_shared_is_declined_for_it
 /// it.
 #[test]
 fn clean_floor_parts_a_degree_off_are_turned_to_the_truth() {
-    let floor = floor("aws_small_house");
-    let pair = mapsim::crop_pair(&floor, &mapsim::CropConfig::default(), 23_031_017).unwrap();
-    let r = register(&pair.a, &pair.b, &RegisterConfig::default()).unwrap();
-    let c = r
-        .accepted
-        .unwrap_or_else(|| panic!("declined: {:?}", r.reason));
+    let (pair, c) = registered_crop("aws_small_house", 23_031_017);
     let disp = displacement_error(&pair.b, &c.transform, &pair.truth).unwrap();
     let rot = rotation_error_deg(&c.transform, &pair.truth);
     // The scan's turn, polished by ICP: 0.21 px and 0.06 degrees off when measured.
