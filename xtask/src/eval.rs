@@ -275,6 +275,11 @@ pub struct EvalArgs {
     /// the library's), for calibration experiments.
     #[arg(long, value_parser = non_negative::<f64>)]
     manhattan_min_reach: Option<f64>,
+    /// Override how much wall lift the Manhattan angle may cost the answer
+    /// (`mapmerge::ManhattanRotation::max_lift_drop`; default: the library's; a large value
+    /// takes it whatever it costs, as before 2026-12-06 evening), for calibration experiments.
+    #[arg(long, value_parser = non_negative::<f64>)]
+    manhattan_max_lift_drop: Option<f64>,
     /// Override how far (degrees) the spectrum angle may lie from the answer's (see
     /// `mapmerge::SpectrumRotation::max_delta_deg`; default: the library's), for calibration
     /// experiments.
@@ -1117,6 +1122,7 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
         mr.max_delta_deg = args.manhattan_max_delta.unwrap_or(mr.max_delta_deg);
         mr.min_lever_px = args.manhattan_min_lever.unwrap_or(mr.min_lever_px);
         mr.min_reach_ratio = args.manhattan_min_reach.unwrap_or(mr.min_reach_ratio);
+        mr.max_lift_drop = args.manhattan_max_lift_drop.unwrap_or(mr.max_lift_drop);
     }
     if args.no_manhattan_rotation {
         config.pair.manhattan_rotation = None;

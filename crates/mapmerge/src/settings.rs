@@ -181,6 +181,7 @@ impl PairConfig {
                     ("min_lever_px", m.min_lever_px),
                     ("min_reach_ratio", m.min_reach_ratio),
                     ("min_wall_residual_px", m.min_wall_residual_px),
+                    ("max_lift_drop", m.max_lift_drop),
                 ],
             )?;
         }
@@ -442,6 +443,9 @@ mod tests {
             }),
             ("pair.manhattan_rotation.max_delta_deg", |c| {
                 c.pair.manhattan_rotation.as_mut().unwrap().max_delta_deg = f64::NAN
+            }),
+            ("pair.manhattan_rotation.max_lift_drop", |c| {
+                c.pair.manhattan_rotation.as_mut().unwrap().max_lift_drop = f64::NAN
             }),
             ("pair.manhattan_rotation.min_contrast", |c| {
                 c.pair.manhattan_rotation.as_mut().unwrap().min_contrast = f64::NAN
