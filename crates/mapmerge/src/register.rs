@@ -267,7 +267,7 @@ pub struct ManhattanRotation {
     /// (large 8000015, floors 8004001) it brought no answer within 3 px. Over `cargo xtask
     /// regress` no outcome changed (those two answers moved 0.1 and 0.4 px nearer the truth);
     /// uos_avz at seed 23 registered 19 instead of 17 of 20 (docs/EVALUATION.md, "A held-out
-    /// seed, and clean maps' misfits turned").
+    /// seed, clean maps' misfits turned, and the Manhattan angle that costs the fit").
     pub max_lift_drop: f64,
 }
 
@@ -338,7 +338,7 @@ pub struct TurnScan {
     /// rescued, 0.21 px off. Over `cargo xtask regress` (every set) one case changed, crops
     /// 7001004, declined -> 0.08 px; `--suites crops` at seeds 8-12 (1,000 pairs) no case
     /// changed, and no pair that shares nothing was accepted (docs/EVALUATION.md, "A held-out
-    /// seed, and clean maps' misfits turned").
+    /// seed, clean maps' misfits turned, and the Manhattan angle that costs the fit").
     pub rescue_misfits: bool,
     /// Not scanned when the answer took its angle from the maps' dominant wall directions
     /// ([`ManhattanRotation`]): that angle comes from every straight wall of both maps, the
