@@ -261,7 +261,7 @@ pub struct ManhattanRotation {
     /// angle is taken though the score prefers the answer's (a tilt of a few tenths of a
     /// degree, above), and on the nav2 warehouse (`cargo xtask eval --suites large`, seeds 7
     /// and 8) the answers it brought within 3 px lost up to 0.077 of lift by it. Where it
-    /// cost 0.13-0.16, the maps' dominant directions missed the overlap's by more than a
+    /// cost 0.13-0.17, the maps' dominant directions missed the overlap's by more than a
     /// tilt: on the uos_avz floor at 30 % overlap (`--suites floors`) it turned two answers
     /// within 0.7 px to 0.8 degrees and 3.3-3.4 px off (held-out seed 23), and elsewhere
     /// (large 8000015, floors 8004001) it brought no answer within 3 px. Over `cargo xtask
