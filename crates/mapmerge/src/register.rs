@@ -1354,17 +1354,36 @@ fn register_as_given(
     let lone_shares = || {
         *lone.get_or_init(|| rayon::join(|| lone_wall_share(pa.grid), || lone_wall_share(pb.grid)))
     };
-    // Whether the bars for maps with clean walls decline a placement verified as `v`.
-    let misfits_clean_walls = |v: &Verification| {
-        let clean_walls = config.verify.clean_walls.is_some_and(|c| {
+    // Why the bars for maps with clean walls decline a placement verified as `v`, if they do
+    // (`VerifyConfig::clean_walls`, then `clean_fit`): the rescue of the turn scan asks it,
+    // and the answer is declined for it below.
+    let clean_walls_misfit = |v: &Verification| -> Option<String> {
+        if let Some(clean) = &config.verify.clean_walls {
             let (sa, sb) = lone_shares();
-            v.mutual_contradiction > c.bar(sa, sb)
-        });
-        clean_walls
-            || config.verify.clean_fit.is_some_and(|f| {
-                let (sa, sb) = lone_shares();
-                f.falls_short(v.wide_wall_lift, sa, sb)
-            })
+            let bar = clean.bar(sa, sb);
+            if v.mutual_contradiction > bar {
+                return Some(format!(
+                    "contradicted: each map puts {:.1} % or more of its compared walls in the other's free space, where maps with walls this clean (lone wall cells {:.1} % and {:.1} %) allow {:.1} %",
+                    100.0 * v.mutual_contradiction,
+                    100.0 * sa,
+                    100.0 * sb,
+                    100.0 * bar
+                ));
+            }
+        }
+        if let Some(fit) = &config.verify.clean_fit {
+            let (sa, sb) = lone_shares();
+            if fit.falls_short(v.wide_wall_lift, sa, sb) {
+                return Some(format!(
+                    "misfit: both maps draw their walls cleanly (lone wall cells {:.1} % and {:.1} %), where a right placement fits its walls at wide lift {:.2} or more; the best fits at {:.2}",
+                    100.0 * sa,
+                    100.0 * sb,
+                    fit.min_wide_wall_lift,
+                    v.wide_wall_lift
+                ));
+            }
+        }
+        None
     };
     // The answer's angle scanned about its overlap (see `TurnScan`), unless it was polished or
     // stood out, as the ascent below, or took the Manhattan angle.
@@ -1381,7 +1400,7 @@ fn register_as_given(
             let (sa, sb) = lone_shares();
             sa.max(sb) <= scan.max_speckle_ratio * sa.min(sb)
         };
-        let rescue = scan.rescue_misfits && misfits_clean_walls(&best.verification);
+        let rescue = scan.rescue_misfits && clean_walls_misfit(&best.verification).is_some();
         let turns = if rescue || (lever >= scan.min_lever_px && alike()) {
             scan.turns()
         } else {
@@ -1409,7 +1428,7 @@ fn register_as_given(
                 let clears = |v: &Verification| {
                     v.accepted(&config.verify)
                         && v.score() > best.verification.score()
-                        && !misfits_clean_walls(v)
+                        && clean_walls_misfit(v).is_none()
                 };
                 if let Some((p, pv)) = polished.filter(|(_, pv)| clears(pv)) {
                     (best.transform, best.verification) = (p, pv);
@@ -1480,32 +1499,8 @@ fn register_as_given(
             );
             return declined(reason, timings, candidates);
         }
-        if let Some(clean) = &config.verify.clean_walls {
-            let (sa, sb) = lone_shares();
-            let bar = clean.bar(sa, sb);
-            if v.mutual_contradiction > bar {
-                let reason = format!(
-                    "contradicted: each map puts {:.1} % or more of its compared walls in the other's free space, where maps with walls this clean (lone wall cells {:.1} % and {:.1} %) allow {:.1} %",
-                    100.0 * v.mutual_contradiction,
-                    100.0 * sa,
-                    100.0 * sb,
-                    100.0 * bar
-                );
-                return declined(reason, timings, candidates);
-            }
-        }
-        if let Some(fit) = &config.verify.clean_fit {
-            let (sa, sb) = lone_shares();
-            if fit.falls_short(v.wide_wall_lift, sa, sb) {
-                let reason = format!(
-                    "misfit: both maps draw their walls cleanly (lone wall cells {:.1} % and {:.1} %), where a right placement fits its walls at wide lift {:.2} or more; the best fits at {:.2}",
-                    100.0 * sa,
-                    100.0 * sb,
-                    fit.min_wide_wall_lift,
-                    v.wide_wall_lift
-                );
-                return declined(reason, timings, candidates);
-            }
+        if let Some(reason) = clean_walls_misfit(v) {
+            return declined(reason, timings, candidates);
         }
         if let Some(bar) = v.crisp_contradiction_bar(&config.verify)
             && v.mutual_contradiction > bar
