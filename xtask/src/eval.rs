@@ -190,6 +190,11 @@ pub struct EvalArgs {
     /// calibration experiments.
     #[arg(long)]
     sweep_size: Option<usize>,
+    /// Override the rotation sweep's largest coarse cell in pixels
+    /// (`mapmerge::global::SweepConfig::max_cell_px`; `inf` for always `--sweep-size` cells;
+    /// default: the library's), to measure what it changes.
+    #[arg(long)]
+    sweep_max_cell: Option<f64>,
     /// Override the wall lift of a RANSAC answer above which the rotation sweep is skipped
     /// (default: the library's), for calibration experiments.
     #[arg(long, value_parser = non_negative::<f64>)]
@@ -1007,6 +1012,7 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
         set(&mut sweep.peak_radius, args.sweep_peak_radius);
         set(&mut sweep.screened, args.sweep_screen);
         set(&mut sweep.coarse_size, args.sweep_size);
+        set(&mut sweep.max_cell_px, args.sweep_max_cell);
         set(&mut sweep.confident_wall_lift, args.confident_lift);
         set(&mut sweep.free_penalty, args.sweep_free_penalty);
         set(&mut sweep.normalized, args.sweep_normalized);

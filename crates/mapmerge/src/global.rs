@@ -293,7 +293,7 @@ impl CoarseField {
         Self::new(
             a,
             b,
-            config.coarse_size,
+            (config.coarse_size, f64::INFINITY),
             config.free_penalty,
             false,
             config.peak_radius,
@@ -302,12 +302,13 @@ impl CoarseField {
     }
 
     /// A's field at a scale where the larger of the sides of A's known cells' bounding box
-    /// and the diagonal of B's spans `coarse_size` cells, padded so that every shift of B
-    /// stays unambiguous.
+    /// and the diagonal of B's spans `coarse_size` cells, or more where a cell would then be
+    /// larger than `max_cell_px` pixels (up to twice as many: [`SweepConfig::max_cell_px`]),
+    /// padded so that every shift of B stays unambiguous.
     fn new(
         a: &PreparedMap,
         b: &PreparedMap,
-        coarse_size: usize,
+        (coarse_size, max_cell_px): (usize, f64),
         free_penalty: f32,
         normalized: bool,
         peak_radius: usize,
@@ -324,7 +325,12 @@ impl CoarseField {
         };
         let ((ka_w, ka_h), (kb_w, kb_h)) = (extent(a), extent(b));
         let known_diag_b = (kb_w as f64).hypot(kb_h as f64);
-        let scale = ((ka_w.max(ka_h) as f64).max(known_diag_b) / coarse_size as f64).max(1.0);
+        // At most `max_cell_px` pixels a cell, but no more than twice `coarse_size` cells.
+        let span = (ka_w.max(ka_h) as f64).max(known_diag_b);
+        let scale = (span / coarse_size as f64)
+            .min(max_cell_px)
+            .max(span / (2 * coarse_size) as f64)
+            .max(1.0);
         let (cw, ch) = (
             (wa / scale).ceil() as usize + 1,
             (ha / scale).ceil() as usize + 1,
@@ -896,6 +902,18 @@ pub struct SweepConfig {
     /// Default 96 (about 5 px per cell for the 400 x 400 simulated maps): coarse enough to be
     /// cheap and to absorb walls that a noisy sensor smeared over several pixels.
     pub coarse_size: usize,
+    /// The largest coarse cell, in pixels: a map whose extent (as for `coarse_size`) would
+    /// put more pixels in a cell gets more than `coarse_size` cells, up to twice as many.
+    /// Default 12 (`f64::INFINITY`: always `coarse_size` cells, the rule before 2026-12-06).
+    /// At `coarse_size` cells the robots' maps of the uos_cic floor (1000-1500 px across) had
+    /// cells of 13-15 px, which smear a large hall's few walls into its clutter: in three of
+    /// the pairs at 30 % overlap declined at seed 23 the placement near the truth ranked
+    /// 101st-139th by the normalised correlation, after the 100 screened, and 29th-82nd with
+    /// cells of at most 12 px (scratch code). With 12, `cargo xtask eval --suites floors --only uos_cic` at
+    /// seeds 7, 8 and 23 registered 13, 15 and 18 of 20 pairs instead of 13, 14 and 15 (at 10,
+    /// 13, 15, 17) and no other floor's row changed; the hard bench pair's registration takes
+    /// 5 % more instructions (`docs/EVALUATION.md`, "Large floors swept on finer cells").
+    pub max_cell_px: f64,
     /// Wall points of B correlated at most. Default 4000.
     pub max_points: usize,
     /// Placements kept, best correlation first, pairwise distinct (see `distinct_px`).
@@ -1005,6 +1023,7 @@ impl Default for SweepConfig {
         Self {
             step_deg: 2.0,
             coarse_size: 96,
+            max_cell_px: 12.0,
             max_points: 4000,
             keep: 8,
             keep_normalized: 24,
@@ -1083,7 +1102,7 @@ pub fn sweep_placements(
     let field = CoarseField::new(
         a,
         b,
-        config.coarse_size,
+        (config.coarse_size, config.max_cell_px),
         config.free_penalty,
         config.normalized,
         config.peak_radius,
@@ -1266,7 +1285,7 @@ mod tests {
         let (pa, pb) = (PreparedMap::new(&a, &vc), PreparedMap::new(&b, &vc));
         let points = strided(&pb.wall_samples, 4000);
         let mut planner = FftPlanner::new();
-        let field = CoarseField::new(&pa, &pb, 96, 0.5, true, 1, &mut planner);
+        let field = CoarseField::new(&pa, &pb, (96, f64::INFINITY), 0.5, true, 1, &mut planner);
         let (mut z, mut second, mut alone) = (Vec::new(), Vec::new(), Vec::new());
         for thetas in [[-0.7, -0.66], [2.0, -3.1], [0.0, 0.0]] {
             let splats = field.correlations(&points, thetas, &mut planner, (&mut z, &mut second));
@@ -1359,6 +1378,48 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn a_large_map_gets_cells_of_at_most_max_cell_px_and_at_most_twice_the_cells() {
+        // A known block of `w` x `h` cells (free, walled round) on a canvas 4 cells larger.
+        let block = |w: usize, h: usize| {
+            let (cw, ch) = (w + 4, h + 4);
+            let mut cells = vec![grid_core::UNKNOWN; cw * ch];
+            for y in 2..2 + h {
+                for x in 2..2 + w {
+                    let wall = x == 2 || y == 2 || x == w + 1 || y == h + 1;
+                    cells[y * cw + x] = if wall { 100 } else { 0 };
+                }
+            }
+            OccupancyGrid::from_cells(cw, ch, 0.05, grid_core::Pose2::default(), cells).unwrap()
+        };
+        let vc = VerifyConfig::default();
+        let b = block(20, 15);
+        let pb = PreparedMap::new(&b, &vc);
+        let scale = |a_side: usize, max_cell_px: f64| {
+            let a = block(a_side, 10);
+            let pa = PreparedMap::new(&a, &vc);
+            CoarseField::new(
+                &pa,
+                &pb,
+                (10, max_cell_px),
+                0.5,
+                true,
+                1,
+                &mut FftPlanner::new(),
+            )
+            .scale
+        };
+        // B's diagonal (25 px) spans the 10 cells when A is smaller ...
+        assert_eq!(scale(20, 4.0), 2.5);
+        // ... and A's side when it is larger: 10 cells of 3 px, within the bound of 4 ...
+        assert_eq!(scale(30, 4.0), 3.0);
+        // ... 15 cells of 4 px rather than 10 of 6 ...
+        assert_eq!(scale(60, 4.0), 4.0);
+        assert_eq!(scale(60, f64::INFINITY), 6.0);
+        // ... and no more than 20 cells, of 5 px rather than 4.
+        assert_eq!(scale(100, 4.0), 5.0);
     }
 
     #[test]

@@ -356,6 +356,7 @@ impl SweepConfig {
         let f = Fields(path);
         f.check("step_deg", self.step_deg, Rule::FinitePositive)?;
         f.check("coarse_size", self.coarse_size as f64, Rule::AtLeastOne)?;
+        f.check("max_cell_px", self.max_cell_px, Rule::AtLeastOne)?;
         f.all(
             Rule::NotNan,
             &[
@@ -755,6 +756,9 @@ mod tests {
             }),
             ("pair.sweep.coarse_size", Rule::AtLeastOne, |c| {
                 c.pair.sweep.as_mut().unwrap().coarse_size = 0
+            }),
+            ("pair.sweep.max_cell_px", Rule::AtLeastOne, |c| {
+                c.pair.sweep.as_mut().unwrap().max_cell_px = f64::NAN
             }),
             ("pair.spectrum_rotation.bins", Rule::AtLeastOne, |c| {
                 c.pair.spectrum_rotation.as_mut().unwrap().bins = 0
