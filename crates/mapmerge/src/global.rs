@@ -909,10 +909,12 @@ pub struct SweepConfig {
     /// cells of 13-15 px, which smear a large hall's few walls into its clutter: in three of
     /// the pairs at 30 % overlap declined at seed 23 the placement near the truth ranked
     /// 101st-139th by the normalised correlation, after the 100 screened, and 29th-82nd with
-    /// cells of at most 12 px (scratch code). With 12, `cargo xtask eval --suites floors --only uos_cic` at
-    /// seeds 7, 8 and 23 registered 13, 15 and 18 of 20 pairs instead of 13, 14 and 15 (at 10,
-    /// 13, 15, 17) and no other floor's row changed; the hard bench pair's registration takes
-    /// 5 % more instructions (`docs/EVALUATION.md`, "Large floors swept on finer cells").
+    /// cells of at most 12 px (scratch code). With 12, the uos_cic floor at 30 % overlap
+    /// (`cargo xtask eval --suites floors`, seeds 7 and 8, and seed 23 of the full table)
+    /// registered 13, 15 and 18 of 20 pairs instead of 13, 14 and 15 (with 10: 13, 15, 17);
+    /// no other floor's row changed, and every row that changed in the regression batch
+    /// (the large floors) rose or held. The hard bench pair's registration takes 5 % more
+    /// instructions (`docs/EVALUATION.md`, "Large floors swept on finer cells").
     pub max_cell_px: f64,
     /// Wall points of B correlated at most. Default 4000.
     pub max_points: usize,

@@ -370,11 +370,7 @@ fn intel_lab_case(seed: u64) -> Case {
 /// Two lidar robots with range noise `noise` exploring the intel lab floor of `fixtures/maps`,
 /// sharing `overlap` of each map.
 fn intel_lab_pair(seed: u64, overlap: f64, noise: &[f64]) -> Case {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../fixtures/maps/intel_lab/intel_lab.yaml"
-    );
-    let floor = grid_core::io::load_map(path, &grid_core::io::LoadOptions::default()).unwrap();
+    let floor = fixture_floor("intel_lab");
     let config = CaseConfig {
         overlap,
         overlap_tolerance: f64::INFINITY,
@@ -526,13 +522,18 @@ fn a_warehouse_pair_whose_best_placement_is_a_quarter_turn_off_is_declined() {
     });
 }
 
-/// The nav2 depot of `fixtures/maps`, a warehouse whose shelf rows repeat.
-fn depot() -> OccupancyGrid {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../fixtures/maps/nav2_depot/nav2_depot.yaml"
+/// The floor `name` of `fixtures/maps` (its `name/name.yaml`).
+fn fixture_floor(name: &str) -> OccupancyGrid {
+    let path = format!(
+        "{}/../../fixtures/maps/{name}/{name}.yaml",
+        env!("CARGO_MANIFEST_DIR")
     );
     grid_core::io::load_map(path, &Default::default()).unwrap()
+}
+
+/// The nav2 depot of `fixtures/maps`, a warehouse whose shelf rows repeat.
+fn depot() -> OccupancyGrid {
+    fixture_floor("nav2_depot")
 }
 
 /// `case`'s pair is declined with a reason that contains `why`.
@@ -610,17 +611,7 @@ fn floor_case(floor: OccupancyGrid, seed: u64) -> Case {
 /// its answer has the angle within 0.03 degrees but the translation 3.07 px off.
 #[test]
 fn a_large_warehouse_pair_takes_its_angle_from_the_walls_at_right_angles() {
-    let case = floor_case(
-        grid_core::io::load_map(
-            concat!(
-                env!("CARGO_MANIFEST_DIR"),
-                "/../../fixtures/maps/nav2_warehouse/nav2_warehouse.yaml"
-            ),
-            &Default::default(),
-        )
-        .unwrap(),
-        7_000_001,
-    );
+    let case = floor_case(fixture_floor("nav2_warehouse"), 7_000_001);
     let (_, error) = registered(&case, &RegisterConfig::default());
     assert!(error.is_some_and(|e| e < 1.5), "{error:?}");
     let mut without = RegisterConfig::default();
@@ -637,15 +628,7 @@ fn a_large_warehouse_pair_takes_its_angle_from_the_walls_at_right_angles() {
 /// (`ManhattanRotation::max_lift_drop`): the answer keeps its own.
 #[test]
 fn a_floor_pair_keeps_its_angle_when_the_walls_at_right_angles_cost_the_fit() {
-    let floor = grid_core::io::load_map(
-        concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../../fixtures/maps/uos_avz/uos_avz.yaml"
-        ),
-        &Default::default(),
-    )
-    .unwrap();
-    let case = floor_case(floor, 23_024_000);
+    let case = floor_case(fixture_floor("uos_avz"), 23_024_000);
     let (_, error) = registered(&case, &RegisterConfig::default());
     assert!(error.is_some_and(|e| e < 1.0), "{error:?}");
     let mut whatever_it_costs = RegisterConfig::default();
@@ -670,15 +653,7 @@ fn a_floor_pair_keeps_its_angle_when_the_walls_at_right_angles_cost_the_fit() {
 /// 12 px (`SweepConfig::max_cell_px`) it ranks 78th and the pair is registered 1.44 px off.
 #[test]
 fn a_large_floor_pair_is_registered_on_finer_sweep_cells() {
-    let floor = grid_core::io::load_map(
-        concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../../fixtures/maps/uos_cic/uos_cic.yaml"
-        ),
-        &Default::default(),
-    )
-    .unwrap();
-    let case = floor_case(floor, 23_022_013);
+    let case = floor_case(fixture_floor("uos_cic"), 23_022_013);
     registered_only_with(&case, "the finer sweep cells", |c| {
         c.pair.sweep.as_mut().unwrap().max_cell_px = f64::INFINITY;
     });
