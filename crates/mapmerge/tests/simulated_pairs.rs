@@ -612,12 +612,26 @@ fn floor_case(floor: OccupancyGrid, seed: u64) -> Case {
 #[test]
 fn a_large_warehouse_pair_takes_its_angle_from_the_walls_at_right_angles() {
     let case = floor_case(fixture_floor("nav2_warehouse"), 7_000_001);
-    let (_, error) = registered(&case, &RegisterConfig::default());
-    assert!(error.is_some_and(|e| e < 1.5), "{error:?}");
-    let mut without = RegisterConfig::default();
-    without.pair.manhattan_rotation = None;
-    let (_, error) = registered(&case, &without);
-    assert!(error.is_some_and(|e| e > 3.0), "without: {error:?}");
+    answered_off_without(&case, 1.5, "the Manhattan angle", |c| {
+        c.pair.manhattan_rotation = None;
+    });
+}
+
+/// `case` is registered less than `within_px` off with the default configuration, and
+/// answered more than 3 px off without `what` (the default with `less` applied).
+fn answered_off_without(
+    case: &Case,
+    within_px: f64,
+    what: &str,
+    less: impl FnOnce(&mut RegisterConfig),
+) {
+    let with = RegisterConfig::default();
+    let (_, error) = registered(case, &with);
+    assert!(error.is_some_and(|e| e < within_px), "{error:?}");
+    let mut without = with;
+    less(&mut without);
+    let (_, error) = registered(case, &without);
+    assert!(error.is_some_and(|e| e > 3.0), "without {what}: {error:?}");
 }
 
 /// Case 23024000 of `cargo xtask eval --suites overlap,zero,paper,real,noise,floors,floorzero,
@@ -629,19 +643,13 @@ fn a_large_warehouse_pair_takes_its_angle_from_the_walls_at_right_angles() {
 #[test]
 fn a_floor_pair_keeps_its_angle_when_the_walls_at_right_angles_cost_the_fit() {
     let case = floor_case(fixture_floor("uos_avz"), 23_024_000);
-    let (_, error) = registered(&case, &RegisterConfig::default());
-    assert!(error.is_some_and(|e| e < 1.0), "{error:?}");
-    let mut whatever_it_costs = RegisterConfig::default();
-    whatever_it_costs
-        .pair
-        .manhattan_rotation
-        .as_mut()
-        .unwrap()
-        .max_lift_drop = f64::INFINITY;
-    let (_, error) = registered(&case, &whatever_it_costs);
-    assert!(
-        error.is_some_and(|e| e > 3.0),
-        "whatever it costs: {error:?}"
+    answered_off_without(
+        &case,
+        1.0,
+        "the lift bar (the angle whatever it costs)",
+        |c| {
+            c.pair.manhattan_rotation.as_mut().unwrap().max_lift_drop = f64::INFINITY;
+        },
     );
 }
 
