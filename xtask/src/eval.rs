@@ -193,7 +193,7 @@ pub struct EvalArgs {
     /// Override the rotation sweep's largest coarse cell in pixels
     /// (`mapmerge::global::SweepConfig::max_cell_px`; `inf` for always `--sweep-size` cells;
     /// default: the library's), to measure what it changes.
-    #[arg(long)]
+    #[arg(long, value_parser = non_negative_or_inf)]
     sweep_max_cell: Option<f64>,
     /// Override the wall lift of a RANSAC answer above which the rotation sweep is skipped
     /// (default: the library's), for calibration experiments.
