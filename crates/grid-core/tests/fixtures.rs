@@ -52,6 +52,17 @@ const EXPECTED: &[Expected] = &[
         occupied: 870,
         unknown: 138683,
     },
+    // 205:245062, 254:14672, 0:1386.
+    Expected {
+        name: "tb_ctrl_room",
+        width: 544,
+        height: 480,
+        resolution: 0.05,
+        origin: [-12.2, -12.2, 0.0],
+        free: 14672,
+        occupied: 1386,
+        unknown: 245062,
+    },
     // 205:183537, 254:63021, 0:3442.
     Expected {
         name: "aws_small_house",

@@ -90,6 +90,17 @@ fn info_json_on_every_fixture() {
             138683,
         ),
         (
+            "tb_ctrl_room",
+            "pgm",
+            544,
+            480,
+            0.05,
+            [-12.2, -12.2, 0.0],
+            14672,
+            1386,
+            245062,
+        ),
+        (
             "aws_small_house",
             "pgm",
             500,
