@@ -121,6 +121,12 @@ pub struct EvalArgs {
     /// minimum overlap; default: the library's), to measure what it changes.
     #[arg(long, value_name = "OVERLAP,LIFT|off", value_parser = crisp_sliver_values)]
     crisp_sliver: Option<CrispSliverArg>,
+    /// Override the fit an answer with a small overlap needs
+    /// (`mapmerge::verify::SmallOverlap`) as `OVERLAP,LIFT`: overlaps under OVERLAP need wall
+    /// lift LIFT (`off` turns the rule off; default: the library's), to measure what it
+    /// changes.
+    #[arg(long, value_name = "OVERLAP,LIFT|off", value_parser = small_overlap_values)]
+    small_overlap: Option<SmallOverlapArg>,
     /// Override the wall lift from which an answer's walls count as crisp and are held to the
     /// misfit bar (`mapmerge::VerifyConfig::crisp_wall_lift`; above `1` turns the rule off;
     /// default: the library's), to measure what it changes.
@@ -585,6 +591,23 @@ fn crisp_sliver_values(s: &str) -> Result<CrispSliverArg, String> {
     )))
 }
 
+/// The value of `--small-overlap`: the rule, or `None` for `off`.
+#[derive(Debug, Clone, Copy)]
+struct SmallOverlapArg(Option<mapmerge::verify::SmallOverlap>);
+
+/// `--small-overlap OVERLAP,LIFT` (two numbers in [0, 1]) or `off`.
+fn small_overlap_values(s: &str) -> Result<SmallOverlapArg, String> {
+    let valid = |g: f64| (0.0..=1.0).contains(&g);
+    let expected = "an overlap fraction and a wall lift in [0, 1] (OVERLAP,LIFT)";
+    let pair = pair_or_off(s, valid, expected)?;
+    Ok(SmallOverlapArg(pair.map(|(below, min_wall_lift)| {
+        mapmerge::verify::SmallOverlap {
+            below,
+            min_wall_lift,
+        }
+    })))
+}
+
 /// `--stand-out LIFT,MARGIN`: two numbers in [0, 1].
 fn stand_out_values(s: &str) -> Result<(f64, f64), String> {
     let v: Vec<f64> = numbers(s)?;
@@ -971,6 +994,9 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
     }
     if let Some(CrispSliverArg(c)) = args.crisp_sliver {
         verify.crisp_sliver = c;
+    }
+    if let Some(SmallOverlapArg(c)) = args.small_overlap {
+        verify.small_overlap = c;
     }
     set(
         &mut verify.max_wall_contradiction,
@@ -1620,7 +1646,7 @@ mod tests {
     use super::{
         EvalArgs, Row, Source, angle_window, clean_fit_values, clean_walls_values,
         crisp_sliver_values, export, finite, fraction, grey_values, non_negative,
-        non_negative_or_inf, positive, slug, stand_out_values,
+        non_negative_or_inf, positive, slug, small_overlap_values, stand_out_values,
     };
     use clap::Parser;
     use grid_core::io::{LoadOptions, load_map};
@@ -1906,6 +1932,16 @@ mod tests {
         let want = "expected an overlap fraction and a wall lift in [0, 1] (OVERLAP,LIFT) or \
                     `off`, got \"0.1,1.5\"";
         assert_eq!(sliver("0.1,1.5"), Err(want.to_string()));
+        let small = |s| small_overlap_values(s).map(|a| a.0);
+        assert_eq!(small("off"), Ok(None));
+        assert_eq!(
+            small("0.25,0.9"),
+            Ok(Some(mapmerge::verify::SmallOverlap {
+                below: 0.25,
+                min_wall_lift: 0.9
+            }))
+        );
+        assert!(small("0.25,NaN").is_err());
         let walls = |s| clean_walls_values(s).map(|a| a.0);
         assert_eq!(walls("off"), Ok(None));
         assert_eq!(

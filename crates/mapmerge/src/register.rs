@@ -1513,6 +1513,18 @@ fn register_as_given(
             );
             return declined(reason, timings, candidates);
         }
+        if let Some(small) = &config.verify.small_overlap
+            && small.falls_short(v)
+        {
+            let reason = format!(
+                "sliver: the best placement shares {:.0} % of the smaller map's known cells, and an overlap under {:.0} % is accepted only where the walls fit crisply (wall lift {:.2} or more; this one {:.2})",
+                100.0 * v.overlap_fraction,
+                100.0 * small.below,
+                small.min_wall_lift,
+                v.wall_lift
+            );
+            return declined(reason, timings, candidates);
+        }
     }
     match candidates.first() {
         Some(best) if best.accepted => {

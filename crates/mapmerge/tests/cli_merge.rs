@@ -437,9 +437,25 @@ fn a_map_that_shares_nothing_with_the_first_is_placed_through_another() {
     let why = report["pairs"][1]["reason"].as_str().unwrap();
     assert!(why.starts_with("contradicted: "), "{why}");
     assert!(why.contains("where maps with walls this clean"), "{why}");
-    // `--no-clean-walls` lifts that bar, and the pair is answered: wrongly, a quarter turn
-    // off, which is what the bar is for.
+    // `--no-clean-walls` lifts that bar; the placement shares under a quarter of the smaller
+    // crop's known cells at a loose fit, and the rule for small overlaps declines it too
+    // (`mapmerge::verify::SmallOverlap`). `--min-overlap 0.15` holds every placement to 15 %
+    // and no more, and then the pair is answered: wrongly, a quarter turn off, which is what
+    // the bars are for.
     let o = common::mapmerge(&["estimate", s(&a), s(&c), "--json", "--no-clean-walls"]);
+    assert_eq!(o.status.code(), Some(3));
+    let declined: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let why = declined["reason"].as_str().unwrap();
+    assert!(why.starts_with("sliver: "), "{why}");
+    let o = common::mapmerge(&[
+        "estimate",
+        s(&a),
+        s(&c),
+        "--json",
+        "--no-clean-walls",
+        "--min-overlap",
+        "0.15",
+    ]);
     assert_eq!(o.status.code(), Some(0));
     let answer: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let truth = to[0].compose(&to[2].inverse());

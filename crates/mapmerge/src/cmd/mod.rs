@@ -136,9 +136,10 @@ pub struct RegistrationArgs {
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// Share of the smaller map's known cells that a placement must find known in both maps
-    /// [default: 0.15, or 0.1 for a placement whose walls fit at wall lift 0.95 or more].
-    /// Given, every placement needs it: lower it for maps that share only a corner, at the
-    /// risk of accepting a sliver where a few walls happen to line up
+    /// [default: 0.15, or 0.1 for a placement whose walls fit at wall lift 0.95 or more; an
+    /// answer under 0.25 needs wall lift 0.9]. Given, every placement needs it and no more:
+    /// lower it for maps that share only a corner, at the risk of accepting a sliver where a
+    /// few walls happen to line up
     #[arg(long, value_name = "FRACTION", value_parser = probability)]
     pub min_overlap: Option<f64>,
     /// Lift the bars that clean maps (few lone wall cells) are held to: an answer is declined
@@ -167,6 +168,7 @@ impl RegistrationArgs {
         if let Some(f) = self.min_overlap {
             config.pair.verify.min_overlap_fraction = f;
             config.pair.verify.crisp_sliver = None;
+            config.pair.verify.small_overlap = None;
         }
         config
     }
