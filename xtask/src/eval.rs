@@ -122,8 +122,8 @@ pub struct EvalArgs {
     #[arg(long, value_name = "OVERLAP,LIFT|off", value_parser = crisp_sliver_values)]
     crisp_sliver: Option<CrispSliverArg>,
     /// Override the fit an answer with a small overlap needs
-    /// (`mapmerge::verify::SmallOverlap`) as `OVERLAP,LIFT`: overlaps under OVERLAP need wall
-    /// lift LIFT (`off` turns the rule off; default: the library's), to measure what it
+    /// (`mapmerge::verify::SmallOverlap`) as `OVERLAP,LIFT`: overlaps under OVERLAP need a
+    /// wide wall lift of LIFT (`off` turns the rule off; default: the library's), to measure what it
     /// changes.
     #[arg(long, value_name = "OVERLAP,LIFT|off", value_parser = small_overlap_values)]
     small_overlap: Option<SmallOverlapArg>,
@@ -387,6 +387,11 @@ pub struct EvalArgs {
     /// so read the accepted rate and the declines' reasons.
     #[arg(long, value_name = "DEG", value_parser = angle_window)]
     bend: Option<f64>,
+    /// Keep only this share of the second part's wall cells in every `crops` and `sensor`
+    /// pair, each drawn at random, the others unknown (`mapsim::CropConfig::keep_walls`: a
+    /// sensor that marks walls only in part); the labels say so.
+    #[arg(long, value_name = "SHARE", value_parser = share_kept)]
+    keep_walls: Option<f64>,
     /// Only the rows whose label contains this text (e.g. `"overlap 0.3"`).
     #[arg(long)]
     only: Option<String>,
@@ -485,6 +490,11 @@ where
     T: std::str::FromStr + Into<f64> + Copy,
 {
     checked(s, |v| v.is_finite() && v > 0.0, "a finite number > 0")
+}
+
+/// A share of cells kept, in `(0, 1]`.
+fn share_kept(s: &str) -> Result<f64, String> {
+    checked(s, |v| v > 0.0 && v <= 1.0, "a number in (0, 1]")
 }
 
 /// A share or a lift, in `[0, 1]`.
@@ -600,10 +610,10 @@ fn small_overlap_values(s: &str) -> Result<SmallOverlapArg, String> {
     let valid = |g: f64| (0.0..=1.0).contains(&g);
     let expected = "an overlap fraction and a wall lift in [0, 1] (OVERLAP,LIFT)";
     let pair = pair_or_off(s, valid, expected)?;
-    Ok(SmallOverlapArg(pair.map(|(below, min_wall_lift)| {
+    Ok(SmallOverlapArg(pair.map(|(below, min_wide_wall_lift)| {
         mapmerge::verify::SmallOverlap {
             below,
-            min_wall_lift,
+            min_wide_wall_lift,
         }
     })))
 }
@@ -1506,6 +1516,18 @@ pub fn run(args: EvalArgs) -> Result<()> {
             }
         }
     }
+    if let Some(keep) = args.keep_walls {
+        for row in &mut rows {
+            if let Source::Crops(_, config) = &mut row.source {
+                config.keep_walls = keep;
+                row.label = format!(
+                    "{}, {:.0}% of the second part's walls kept",
+                    row.label,
+                    keep * 100.0
+                );
+            }
+        }
+    }
     let defaults = register_config(&args);
     // Settings the flags' parsers let through but the library refuses (a grid size of 0)
     // stop the run here, once, instead of failing every case.
@@ -1646,7 +1668,7 @@ mod tests {
     use super::{
         EvalArgs, Row, Source, angle_window, clean_fit_values, clean_walls_values,
         crisp_sliver_values, export, finite, fraction, grey_values, non_negative,
-        non_negative_or_inf, positive, slug, small_overlap_values, stand_out_values,
+        non_negative_or_inf, positive, share_kept, slug, small_overlap_values, stand_out_values,
     };
     use clap::Parser;
     use grid_core::io::{LoadOptions, load_map};
@@ -1916,6 +1938,11 @@ mod tests {
         assert_eq!(stand_out_values("0.7"), Err(want.to_string()));
         assert!(stand_out_values("0.7,NaN").is_err());
         assert!(stand_out_values("0.7,1.5").is_err());
+        assert_eq!(share_kept("0.5"), Ok(0.5));
+        assert_eq!(share_kept("1"), Ok(1.0));
+        for bad in ["0", "1.5", "NaN", "-0.1"] {
+            assert!(share_kept(bad).is_err(), "{bad}");
+        }
     }
 
     #[test]
@@ -1935,10 +1962,10 @@ mod tests {
         let small = |s| small_overlap_values(s).map(|a| a.0);
         assert_eq!(small("off"), Ok(None));
         assert_eq!(
-            small("0.25,0.9"),
+            small("0.25,0.97"),
             Ok(Some(mapmerge::verify::SmallOverlap {
                 below: 0.25,
-                min_wall_lift: 0.9
+                min_wide_wall_lift: 0.97
             }))
         );
         assert!(small("0.25,NaN").is_err());

@@ -1517,11 +1517,11 @@ fn register_as_given(
             && small.falls_short(v)
         {
             let reason = format!(
-                "sliver: the best placement shares {:.0} % of the smaller map's known cells, and an overlap under {:.0} % is accepted only where the walls fit crisply (wall lift {:.2} or more; this one {:.2})",
+                "sliver: the best placement shares {:.0} % of the smaller map's known cells, and an overlap under {:.0} % is accepted only where the walls fit almost everywhere (wide wall lift {:.2} or more; this one {:.2})",
                 100.0 * v.overlap_fraction,
                 100.0 * small.below,
-                small.min_wall_lift,
-                v.wall_lift
+                small.min_wide_wall_lift,
+                v.wide_wall_lift
             );
             return declined(reason, timings, candidates);
         }

@@ -309,7 +309,10 @@ impl VerifyConfig {
         if let Some(s) = &self.small_overlap {
             Fields(&f.path("small_overlap")).all(
                 Rule::NotNan,
-                &[("below", s.below), ("min_wall_lift", s.min_wall_lift)],
+                &[
+                    ("below", s.below),
+                    ("min_wide_wall_lift", s.min_wide_wall_lift),
+                ],
             )?;
         }
         if let Some(s) = &self.stand_out {
@@ -564,8 +567,13 @@ mod tests {
             ("pair.verify.small_overlap.below", |c| {
                 c.pair.verify.small_overlap.as_mut().unwrap().below = f64::NAN
             }),
-            ("pair.verify.small_overlap.min_wall_lift", |c| {
-                c.pair.verify.small_overlap.as_mut().unwrap().min_wall_lift = f64::NAN
+            ("pair.verify.small_overlap.min_wide_wall_lift", |c| {
+                c.pair
+                    .verify
+                    .small_overlap
+                    .as_mut()
+                    .unwrap()
+                    .min_wide_wall_lift = f64::NAN
             }),
             ("pair.verify.clean_walls.base", |c| {
                 c.pair.verify.clean_walls.as_mut().unwrap().base = f64::NAN

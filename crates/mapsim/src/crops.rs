@@ -32,6 +32,10 @@ pub struct CropConfig {
     /// so the part's two ends turn by `-bend_deg` and `+bend_deg`. The truth stays the
     /// unbent one, which the middle of the part keeps. Default 0.
     pub bend_deg: f64,
+    /// Share of the second part's wall cells kept, each drawn at random; the others become
+    /// unknown, as a sensor that marks walls only in part leaves them (a glancing beam, a
+    /// surface that returns little). In `(0, 1]`. Default 1: every wall cell kept.
+    pub keep_walls: f64,
 }
 
 impl Default for CropConfig {
@@ -41,6 +45,7 @@ impl Default for CropConfig {
             cut: (0.35, 0.65),
             margin: 10,
             bend_deg: 0.0,
+            keep_walls: 1.0,
         }
     }
 }
@@ -71,11 +76,12 @@ pub struct CropPair {
 pub fn crop_pair(map: &OccupancyGrid, config: &CropConfig, seed: u64) -> Result<CropPair> {
     let (lo, hi) = config.cut;
     let valid = (0.0..1.0).contains(&config.overlap) && 0.0 < lo && lo <= hi && hi < 1.0;
-    if !valid || !config.bend_deg.is_finite() {
+    let keeps = config.keep_walls > 0.0 && config.keep_walls <= 1.0;
+    if !valid || !config.bend_deg.is_finite() || !keeps {
         return Err(Error::Config(format!(
-            "crop overlap {} must lie in [0, 1), the cut range {:?} within (0, 1) and the bend \
-             {} be finite",
-            config.overlap, config.cut, config.bend_deg
+            "crop overlap {} must lie in [0, 1), the cut range {:?} within (0, 1), the bend \
+             {} be finite and the share of walls kept {} lie in (0, 1]",
+            config.overlap, config.cut, config.bend_deg, config.keep_walls
         )));
     }
     let Some((x0, y0, w, h)) = map.known_bounds(0) else {
@@ -159,6 +165,16 @@ pub fn crop_pair(map: &OccupancyGrid, config: &CropConfig, seed: u64) -> Result<
             half_across,
             config.bend_deg.to_radians(),
         );
+    }
+    if config.keep_walls < 1.0 {
+        // Drawn after the cut and the angle, so that those stay what the seed gave them.
+        for cell in b.cells_mut() {
+            if OccupancyGrid::classify(*cell) == CellState::Occupied
+                && rng.random::<f64>() >= config.keep_walls
+            {
+                *cell = UNKNOWN;
+            }
+        }
     }
     let b = b
         .warp(&map_to_b, side, side)
@@ -334,5 +350,48 @@ mod tests {
             ),
             Err(Error::Config(_))
         ));
+    }
+
+    #[test]
+    fn a_part_with_walls_marked_in_part_keeps_that_share_of_them_and_nothing_else_changes() {
+        let map = room();
+        let whole = crop_pair(&map, &CropConfig::default(), 5).unwrap();
+        let config = CropConfig {
+            keep_walls: 0.5,
+            ..CropConfig::default()
+        };
+        let pair = crop_pair(&map, &config, 5).unwrap();
+        // The same cut and angle: only the second part's walls thin out.
+        assert_eq!(
+            (&pair.a, pair.truth, pair.overlap),
+            (&whole.a, whole.truth, whole.overlap)
+        );
+        let count = |b: &OccupancyGrid, state| {
+            let w = b.width();
+            (0..b.cells().len())
+                .filter(|&i| b.state(i % w, i / w) == state)
+                .count()
+        };
+        let (all, kept) = (
+            count(&whole.b, CellState::Occupied),
+            count(&pair.b, CellState::Occupied),
+        );
+        assert!(
+            (0.35..0.65).contains(&(kept as f64 / all as f64)),
+            "{kept} of {all}"
+        );
+        // Free cells stay free; the dropped walls become unknown.
+        assert_eq!(
+            count(&pair.b, CellState::Free),
+            count(&whole.b, CellState::Free)
+        );
+        assert_eq!(pair, crop_pair(&map, &config, 5).unwrap());
+        for keep_walls in [0.0, 1.5, f64::NAN] {
+            let config = CropConfig {
+                keep_walls,
+                ..config
+            };
+            assert!(matches!(crop_pair(&map, &config, 1), Err(Error::Config(_))));
+        }
     }
 }
