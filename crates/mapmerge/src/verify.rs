@@ -74,8 +74,7 @@ pub struct VerifyConfig {
     /// holds every placement to [`Self::min_overlap_fraction`].
     pub crisp_sliver: Option<CrispSliver>,
     /// An answer whose overlap is small needs walls that fit almost everywhere
-    /// ([`SmallOverlap`]).
-    /// Applied to the answer only, after the ambiguity test, as
+    /// ([`SmallOverlap`]). Applied to the answer only, after the ambiguity test, as
     /// [`Self::max_wall_contradiction`]. `None` turns it off.
     pub small_overlap: Option<SmallOverlap>,
     /// A pair is ambiguous, and declined, when a second accepted candidate that differs from
@@ -356,7 +355,7 @@ impl Default for CrispSliver {
 /// borders meet along a stretch of wall or two whatever the placement. Real robots' partial
 /// maps cut in two with nothing shared (`cargo xtask eval --suites sensor`, seeds 7-9: the
 /// TurtleBot control room, never tuned on, and the README's real pair) were answered in 18
-/// of 180 pairs, 12 of them slivers of 15-21 % at wide lift 0.81-0.87. Over every run of
+/// of 180 pairs, 12 of them slivers of 15-21 % at wide lift 0.81-0.89. Over every run of
 /// the eval kept from 2026-12-06 (the regression batch, the seed-7 table, the held-out seed
 /// 23, both mappers at 10-50 % range noise, and those), all 79 answers within 3 px that
 /// overlapped less than 25 % fitted at wide lift 0.999 or more (crisp maps cut in two), and

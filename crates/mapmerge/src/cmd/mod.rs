@@ -138,9 +138,8 @@ pub struct RegistrationArgs {
     /// Share of the smaller map's known cells that a placement must find known in both maps
     /// [default: 0.15, or 0.1 for a placement whose walls fit at wall lift 0.95 or more; an
     /// answer under 0.25 needs a wide wall lift of 0.97]. Given, every placement needs it and
-    /// no more:
-    /// lower it for maps that share only a corner, at the risk of accepting a sliver where a
-    /// few walls happen to line up
+    /// no more: lower it for maps that share only a corner, at the risk of accepting a sliver
+    /// where a few walls happen to line up
     #[arg(long, value_name = "FRACTION", value_parser = probability)]
     pub min_overlap: Option<f64>,
     /// Lift the bars that clean maps (few lone wall cells) are held to: an answer is declined
