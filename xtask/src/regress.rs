@@ -24,8 +24,8 @@ Sets (20 cases per row, as in docs/EVALUATION.md):
   crops   the same floors cut in two, sharing 30 % or nothing (must decline), seed 7
   sensor  three real robots' partial maps cut in two the same way, seeds 7, 8, 9
 The batch without `sensor` (2,100 cases) took 18 minutes on a 2-core Intel Xeon VM
-(2026-12-06, 02:09-02:27 UTC); `sensor` (360 cases) takes about a minute more. `cargo xtask calibrate DIR` then tabulates its answers' errors by
-confidence.
+(2026-12-06, 02:09-02:27 UTC); `sensor` (360 cases) takes about a minute more. `cargo
+xtask calibrate DIR` then tabulates its answers' errors by confidence.
 
 Examples:
   cargo xtask regress --out /tmp/before
