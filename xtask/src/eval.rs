@@ -588,11 +588,17 @@ fn clean_fit_values(s: &str) -> Result<CleanFitArg, String> {
 #[derive(Debug, Clone, Copy)]
 struct CrispSliverArg(Option<mapmerge::verify::CrispSliver>);
 
-/// `--crisp-sliver OVERLAP,LIFT` (two numbers in [0, 1]) or `off`.
-fn crisp_sliver_values(s: &str) -> Result<CrispSliverArg, String> {
+/// `OVERLAP,LIFT` (two numbers in [0, 1]) or `off`: the values of `--crisp-sliver` and
+/// `--small-overlap`.
+fn overlap_and_lift(s: &str) -> Result<Option<(f64, f64)>, String> {
     let valid = |g: f64| (0.0..=1.0).contains(&g);
     let expected = "an overlap fraction and a wall lift in [0, 1] (OVERLAP,LIFT)";
-    let pair = pair_or_off(s, valid, expected)?;
+    pair_or_off(s, valid, expected)
+}
+
+/// `--crisp-sliver OVERLAP,LIFT` (two numbers in [0, 1]) or `off`.
+fn crisp_sliver_values(s: &str) -> Result<CrispSliverArg, String> {
+    let pair = overlap_and_lift(s)?;
     Ok(CrispSliverArg(pair.map(
         |(min_overlap_fraction, min_wall_lift)| mapmerge::verify::CrispSliver {
             min_overlap_fraction,
@@ -607,9 +613,7 @@ struct SmallOverlapArg(Option<mapmerge::verify::SmallOverlap>);
 
 /// `--small-overlap OVERLAP,LIFT` (two numbers in [0, 1]) or `off`.
 fn small_overlap_values(s: &str) -> Result<SmallOverlapArg, String> {
-    let valid = |g: f64| (0.0..=1.0).contains(&g);
-    let expected = "an overlap fraction and a wall lift in [0, 1] (OVERLAP,LIFT)";
-    let pair = pair_or_off(s, valid, expected)?;
+    let pair = overlap_and_lift(s)?;
     Ok(SmallOverlapArg(pair.map(|(below, min_wide_wall_lift)| {
         mapmerge::verify::SmallOverlap {
             below,
