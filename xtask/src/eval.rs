@@ -381,6 +381,11 @@ pub struct EvalArgs {
     /// (robot rows only; the labels say so), to measure a change on maps of other noise.
     #[arg(long, value_parser = noise_value)]
     noise: Option<f64>,
+    /// The first robot's range noise bound alone (map A), after `--noise` (robot rows only;
+    /// the labels say so): with `--suites mismatch`, a quiet robot's map paired with noisier
+    /// ones.
+    #[arg(long, value_parser = noise_value)]
+    noise_first: Option<f64>,
     /// Bend the second part of every `crops` pair by this angle at each end, in degrees
     /// (`mapsim::CropConfig::bend_deg`: a map built with a drifting heading), against the
     /// unbent truth; the labels say so. The displacement error then includes the bend itself,
@@ -1509,6 +1514,16 @@ pub fn run(args: EvalArgs) -> Result<()> {
                     robot.noise_bound = noise;
                 }
                 row.label = format!("{}, every noise set to {:.0}%", row.label, noise * 100.0);
+            }
+        }
+    }
+    if let Some(noise) = args.noise_first {
+        for row in &mut rows {
+            if let Source::Robots(config) = &mut row.source
+                && let Some(first) = config.robots.first_mut()
+            {
+                first.noise_bound = noise;
+                row.label = format!("{}, first robot's noise {:.0}%", row.label, noise * 100.0);
             }
         }
     }
