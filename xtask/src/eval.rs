@@ -2,10 +2,10 @@
 //! regenerate from a seed.
 //!
 //! Each suite is a family of simulated two-robot cases (mapsim) with known truth, or of real
-//! maps cut in two (`mapsim::crop_pair`; `--pictures` draws them without world or paths). A case is a
-//! success when the pair is accepted and the displacement error (mean over B's known cells of
-//! `|T_est(p) - T_true(p)|`) is at most 3 px, as the project's conventions define; in the
-//! zero-overlap suite, a success is a decline.
+//! maps cut in two (`mapsim::crop_pair`; `--pictures` draws them without world or paths). A
+//! case is a success when the pair is accepted and the displacement error (mean over B's known
+//! cells of `|T_est(p) - T_true(p)|`) is at most 3 px, as the project's conventions define; in
+//! the zero-overlap suite, a success is a decline.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -123,8 +123,8 @@ pub struct EvalArgs {
     crisp_sliver: Option<CrispSliverArg>,
     /// Override the fit an answer with a small overlap needs
     /// (`mapmerge::verify::SmallOverlap`) as `OVERLAP,LIFT`: overlaps under OVERLAP need a
-    /// wide wall lift of LIFT (`off` turns the rule off; default: the library's), to measure what it
-    /// changes.
+    /// wide wall lift of LIFT (`off` turns the rule off; default: the library's), to measure
+    /// what it changes.
     #[arg(long, value_name = "OVERLAP,LIFT|off", value_parser = small_overlap_values)]
     small_overlap: Option<SmallOverlapArg>,
     /// Override the wall lift from which an answer's walls count as crisp and are held to the
