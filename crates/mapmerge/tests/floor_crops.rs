@@ -72,7 +72,16 @@ fn nothing_shared(name: &str, seed: u64) -> (mapsim::CropPair, String) {
 /// Fixture floor `name` cut in two, the parts sharing 30 % of their extent (case `seed` of
 /// `cargo xtask eval --suites crops`' 30 % rows), and its answer with the default settings.
 fn registered_crop(name: &str, seed: u64) -> (mapsim::CropPair, mapmerge::Candidate) {
-    let pair = mapsim::crop_pair(&floor(name), &mapsim::CropConfig::default(), seed).unwrap();
+    registered_crop_with(name, &mapsim::CropConfig::default(), seed)
+}
+
+/// [`registered_crop`] with the pair cut as `config` says.
+fn registered_crop_with(
+    name: &str,
+    config: &mapsim::CropConfig,
+    seed: u64,
+) -> (mapsim::CropPair, mapmerge::Candidate) {
+    let pair = mapsim::crop_pair(&floor(name), config, seed).unwrap();
     let r = register(&pair.a, &pair.b, &RegisterConfig::default()).unwrap();
     let c = r
         .accepted
@@ -269,11 +278,7 @@ fn a_small_overlap_with_walls_marked_in_part_is_registered() {
         keep_walls: 0.3,
         ..Default::default()
     };
-    let pair = mapsim::crop_pair(&floor("intel_lab"), &config, 7_003_001).unwrap();
-    let r = register(&pair.a, &pair.b, &RegisterConfig::default()).unwrap();
-    let c = r
-        .accepted
-        .unwrap_or_else(|| panic!("declined: {:?}", r.reason));
+    let (pair, c) = registered_crop_with("intel_lab", &config, 7_003_001);
     let v = c.verification;
     assert!(v.overlap_fraction < 0.25 && v.wall_lift < 0.9, "{v:?}");
     let disp = displacement_error(&pair.b, &c.transform, &pair.truth).unwrap();
