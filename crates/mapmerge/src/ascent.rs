@@ -41,7 +41,14 @@ pub struct AscentConfig {
     /// map: the score there peaks 3-5 px from the truth, and climbing it registered 3 more and
     /// 18 fewer of the 120 pairs at 30 % overlap (seeds 7-9). Hector's model marks walls about
     /// two cells thick and in place (1.25-1.76); the floors of `fixtures/maps` measure
-    /// 0.65-2.34 as drawn (docs/EVALUATION.md, "The score ascent").
+    /// 0.65-2.34 as drawn (docs/EVALUATION.md, "The score ascent"). A short-range sensor
+    /// with few beams also leaves one-cell walls, but little pushed: on mapsim's paper preset
+    /// (16-beam infrared rings, range 30 cells) at 30 % overlap the ascent without this gate
+    /// registered 50 instead of 45 of 63 pairs (seeds 7, 8, 9, 23), where the default
+    /// mapper's lidar rows at 30 % overlap lost 17 of 40 (seed 7). The map does not tell the
+    /// two sensors apart, so the user does: `mapmerge estimate|merge --climb` sets 0
+    /// (docs/EVALUATION.md, "A second held-out seed, and the score ascent on the paper's
+    /// sensor").
     pub min_wall_thickness: f64,
     /// What the climb maximises: [`Verification::score`] less this many times the wall
     /// cells that land in the other map's free space (`wall_contradiction * wall_support`).
