@@ -251,7 +251,8 @@ pub struct EvalArgs {
     /// (`mapmerge::TurnScan::keep_manhattan_angle` false).
     #[arg(long)]
     turn_scan_after_manhattan: bool,
-    /// The wall thickness both maps need for the ascent (`AscentConfig::min_wall_thickness`).
+    /// The wall thickness both maps need for the ascent (`AscentConfig::min_wall_thickness`;
+    /// 0 is what `mapmerge estimate|merge --climb` sets).
     #[arg(long, value_name = "CELLS", value_parser = non_negative::<f64>)]
     ascent_min_thickness: Option<f64>,
     /// How much the ascent's objective weighs a contradicting wall cell
