@@ -152,11 +152,12 @@ pub struct RegistrationArgs {
     #[arg(long)]
     pub no_clean_walls: bool,
     /// Let the answer climb the verification score on walls of any thickness. By default it
-    /// climbs only on walls about two cells thick, as scan-matching mappers draw them. Give it for short-range sensors with few beams, such as the paper's 16-beam
-    /// infrared ring: their maps' walls are one cell thick and dotted, ICP leaves the answer
-    /// a few pixels or degrees off, and the score peaks at the truth. Not for a long-range
-    /// lidar's one-cell walls: range noise pushes those behind the obstacle faces, and the
-    /// climb follows the push away from the truth
+    /// climbs only on walls about two cells thick, as scan-matching mappers draw them. Give
+    /// it for short-range sensors with few beams, such as the paper's 16-beam infrared ring:
+    /// their maps' walls are one cell thick and dotted, ICP leaves the answer a few pixels or
+    /// degrees off, and the score peaks at the truth. Not for a long-range lidar's one-cell
+    /// walls: range noise pushes those behind the obstacle faces, and the climb follows the
+    /// push away from the truth
     #[arg(long)]
     pub climb: bool,
 }
