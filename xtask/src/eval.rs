@@ -255,6 +255,14 @@ pub struct EvalArgs {
     /// 0 is what `mapmerge estimate|merge --climb` sets).
     #[arg(long, value_name = "CELLS", value_parser = non_negative::<f64>)]
     ascent_min_thickness: Option<f64>,
+    /// The frontier cells per free cell beside a wall that both maps need for the ascent on
+    /// thinner walls (`mapmerge::ascent::ShortRange::min_frontier_ratio`; `inf`: never).
+    #[arg(long, value_name = "RATIO", value_parser = non_negative_or_inf)]
+    ascent_frontier_ratio: Option<f64>,
+    /// The wall lift an answer must stay below for the ascent on thinner walls
+    /// (`mapmerge::ascent::ShortRange::max_wall_lift`).
+    #[arg(long, value_name = "LIFT", value_parser = non_negative::<f64>)]
+    ascent_short_range_lift: Option<f64>,
     /// How much the ascent's objective weighs a contradicting wall cell
     /// (`AscentConfig::contradiction_weight`).
     #[arg(long, value_name = "W", value_parser = non_negative::<f64>)]
@@ -1121,6 +1129,19 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
     if let (Some(t), Some(ascent)) = (args.ascent_min_thickness, config.pair.ascent.as_mut()) {
         ascent.min_wall_thickness = t;
     }
+    if let Some(sr) = config
+        .pair
+        .ascent
+        .as_mut()
+        .and_then(|a| a.short_range.as_mut())
+    {
+        if let Some(r) = args.ascent_frontier_ratio {
+            sr.min_frontier_ratio = r;
+        }
+        if let Some(l) = args.ascent_short_range_lift {
+            sr.max_wall_lift = l;
+        }
+    }
     if let (Some(w), Some(ascent)) = (
         args.ascent_contradiction_weight,
         config.pair.ascent.as_mut(),
@@ -1890,6 +1911,8 @@ mod tests {
             "--turn-scan-lever",
             "--turn-scan-speckle-ratio",
             "--ascent-min-thickness",
+            "--ascent-frontier-ratio",
+            "--ascent-short-range-lift",
             "--ascent-contradiction-weight",
             "--manhattan-min-contrast",
             "--manhattan-max-delta",

@@ -10,7 +10,7 @@ use ransac_rigid::{RansacConfig, estimate_rigid};
 use sift_desc::{SiftConfig, SiftCorrespondences};
 
 use crate::Error;
-use crate::ascent::{AscentConfig, ascend, lone_wall_share, wall_thickness};
+use crate::ascent::{AscentConfig, ascend, frontier_ratio, lone_wall_share, wall_thickness};
 use crate::global::{
     GlobalConfig, SweepConfig, global_hypotheses, manhattan_direction, spectrum_rotation_near,
     sweep_placements, twins,
@@ -130,7 +130,8 @@ pub struct PairConfig {
     /// that stops once converged").
     pub refined_placements: Option<usize>,
     /// A last climb of the accepted answer's verification score ([`crate::ascent`]) when both
-    /// maps' walls are thick enough ([`AscentConfig::min_wall_thickness`]), kept when it
+    /// maps' walls are thick enough ([`AscentConfig::min_wall_thickness`]) or both maps come
+    /// from a short-range sensor ([`AscentConfig::short_range`]), kept when it
     /// scores higher and still passes; not for an answer polished
     /// ([`PolishConfig::min_wall_lift`]) or one that stood out. `None` disables it. Default:
     /// on, [`AscentConfig::default`]. On the 30 % overlap rows of `cargo xtask eval` mapped
@@ -1450,7 +1451,16 @@ fn register_as_given(
     {
         let t0 = Instant::now();
         let (ta, tb) = rayon::join(|| wall_thickness(pa.grid), || wall_thickness(pb.grid));
-        if ta.min(tb) >= ascent.min_wall_thickness {
+        let short_range = || {
+            ascent.short_range.is_some_and(|sr| {
+                best.verification.wall_lift < sr.max_wall_lift && {
+                    let (fa, fb) =
+                        rayon::join(|| frontier_ratio(pa.grid), || frontier_ratio(pb.grid));
+                    fa.min(fb) >= sr.min_frontier_ratio
+                }
+            })
+        };
+        if ta.min(tb) >= ascent.min_wall_thickness || short_range() {
             let (t, v) = ascend(&pa, &pb, &best.transform, ascent, &config.verify);
             if t != best.transform && v.accepted(&config.verify) {
                 (best.transform, best.verification) = (t, v);

@@ -202,6 +202,11 @@ impl PairConfig {
                 ],
             )?;
             f.check("min_wall_thickness", a.min_wall_thickness, Rule::NotNan)?;
+            if let Some(sr) = &a.short_range {
+                let f = Fields(&sub("ascent.short_range"));
+                f.check("min_frontier_ratio", sr.min_frontier_ratio, Rule::NotNan)?;
+                f.check("max_wall_lift", sr.max_wall_lift, Rule::NotNan)?;
+            }
         }
         if let Some(t) = &self.turn_scan {
             let f = Fields(&sub("turn_scan"));
@@ -721,6 +726,14 @@ mod tests {
             }),
             ("pair.ascent.min_wall_thickness", |c| {
                 c.pair.ascent.as_mut().unwrap().min_wall_thickness = f64::NAN
+            }),
+            ("pair.ascent.short_range.min_frontier_ratio", |c| {
+                let ascent = c.pair.ascent.as_mut().unwrap();
+                ascent.short_range.as_mut().unwrap().min_frontier_ratio = f64::NAN
+            }),
+            ("pair.ascent.short_range.max_wall_lift", |c| {
+                let ascent = c.pair.ascent.as_mut().unwrap();
+                ascent.short_range.as_mut().unwrap().max_wall_lift = f64::NAN
             }),
             ("pair.ascent.contradiction_weight", |c| {
                 c.pair.ascent.as_mut().unwrap().contradiction_weight = f64::NAN

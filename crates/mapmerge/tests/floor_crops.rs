@@ -284,3 +284,35 @@ fn a_small_overlap_with_walls_marked_in_part_is_registered() {
     let disp = displacement_error(&pair.b, &c.transform, &pair.truth).unwrap();
     assert!(disp < 0.5, "{disp} px off");
 }
+
+/// Case 7001005 of `cargo xtask eval --suites sensor --seed 7`: the README's real robot's map
+/// A (`sunil_pair_a`) cut in two, the parts sharing 30 % of their extent, registered 0.03 px
+/// off. The cut leaves long frontiers, so both parts look like a short-range sensor's maps
+/// (frontier ratio 1.2 or more), but the answer's walls agree almost everywhere (wall lift
+/// 0.955): it is not climbed (`mapmerge::ascent::ShortRange::max_wall_lift`), where the
+/// climb's whole-cell steps would take it 1.0 px off.
+#[test]
+fn a_crisp_answer_is_not_climbed_for_its_frontiers_alone() {
+    let config = mapsim::CropConfig {
+        overlap: 0.3,
+        ..Default::default()
+    };
+    let pair = mapsim::crop_pair(&floor("sunil_pair_a"), &config, 7_001_005).unwrap();
+    let (fa, fb) = (
+        mapmerge::ascent::frontier_ratio(&pair.a),
+        mapmerge::ascent::frontier_ratio(&pair.b),
+    );
+    assert!(fa.min(fb) >= 1.2, "frontier ratios {fa}, {fb}");
+    let error = |config: &RegisterConfig| {
+        let r = register(&pair.a, &pair.b, config).unwrap();
+        let answer = r.accepted.expect("registered");
+        displacement_error(&pair.b, &answer.transform, &pair.truth).unwrap()
+    };
+    let default = error(&RegisterConfig::default());
+    assert!(default < 0.2, "{default} px off");
+    let mut climbed = RegisterConfig::default();
+    let ascent = climbed.pair.ascent.as_mut().unwrap();
+    ascent.short_range.as_mut().unwrap().max_wall_lift = 1.0;
+    let climbed = error(&climbed);
+    assert!(climbed > 0.5, "climbed: {climbed} px off");
+}

@@ -152,12 +152,13 @@ pub struct RegistrationArgs {
     #[arg(long)]
     pub no_clean_walls: bool,
     /// Let the answer climb the verification score on walls of any thickness. By default it
-    /// climbs only on walls about two cells thick, as scan-matching mappers draw them. Give
-    /// it for short-range sensors with few beams, such as the paper's 16-beam infrared ring:
-    /// their maps' walls are one cell thick and dotted, ICP leaves the answer a few pixels or
-    /// degrees off, and the score peaks at the truth. Not for a long-range lidar's one-cell
-    /// walls: range noise pushes those behind the obstacle faces, and the climb follows the
-    /// push away from the truth
+    /// climbs on walls about two cells thick, as scan-matching mappers draw them, and on the
+    /// thin walls of maps whose free space borders unknown more than it borders walls (a
+    /// short-range sensor with few beams, such as the paper's 16-beam infrared ring: its maps'
+    /// walls are one cell thick and dotted, ICP leaves the answer a few pixels or degrees off,
+    /// and the score peaks at the truth). Give it for such a sensor whose maps do not show it.
+    /// Not for a long-range lidar's one-cell walls: range noise pushes those behind the
+    /// obstacle faces, and the climb follows the push away from the truth
     #[arg(long)]
     pub climb: bool,
 }
