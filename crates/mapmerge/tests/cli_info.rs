@@ -41,6 +41,11 @@ fn thickness(yaml: &std::path::Path) -> f64 {
     mapmerge::ascent::wall_thickness(&load(yaml))
 }
 
+/// The frontier ratio of the map `yaml`, as `mapmerge::ascent::frontier_ratio` measures it.
+fn frontier(yaml: &std::path::Path) -> f64 {
+    mapmerge::ascent::frontier_ratio(&load(yaml))
+}
+
 /// The share of lone wall cells of the map `yaml`, as `mapmerge::ascent::lone_wall_share`
 /// measures it.
 fn lone_share(yaml: &std::path::Path) -> f64 {
@@ -226,6 +231,7 @@ fn info_json_on_every_fixture() {
         let mut got = got;
         for (key, want) in [
             ("wall_thickness", thickness(&yaml)),
+            ("frontier_ratio", frontier(&yaml)),
             ("lone_wall_share", lone_share(&yaml)),
         ] {
             let reported = got
@@ -258,11 +264,13 @@ fn info_human_form() {
          occupied:   3711 (6.2%)\n\
          unknown:    21769 (36.3%)\n\
          walls:      1.13 cells thick (occupied cells per side facing free space)\n\
+         frontier:   0.53 free cells beside unknown per free cell beside a wall (high for a short-range sensor)\n\
          speckle:    0.8% of occupied cells lone (no occupied neighbour; grows with range noise)\n",
         yaml.display(),
         fixture("wpi_ilab", "pgm").display()
     );
     assert_eq!(format!("{:.2}", thickness(&yaml)), "1.13");
+    assert_eq!(format!("{:.2}", frontier(&yaml)), "0.53");
     assert_eq!(format!("{:.1}", 100.0 * lone_share(&yaml)), "0.8");
     assert_eq!(text, want);
 }
