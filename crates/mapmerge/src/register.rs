@@ -289,7 +289,7 @@ impl Default for ManhattanRotation {
 /// A scan of the answer's angle: B turned about the centre of its walls on A's known cells
 /// (so the shared walls stay in place) by every multiple of `step_deg` up to `max_deg` each
 /// way, each turn's translation and range-bias offsets refined by ICP with the angle held,
-/// and verified ([`at_angle`]); the best-scoring turn that passes replaces the answer if it
+/// and verified (`at_angle`); the best-scoring turn that passes replaces the answer if it
 /// scores higher.
 ///
 /// The local and turn searches turn B about the centre of all its walls, which on a small

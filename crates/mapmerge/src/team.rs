@@ -95,7 +95,8 @@ fn edge_weight(v: &crate::verify::Verification) -> f64 {
 /// Merge a team's `maps`, weighted by `weights` (each map's reliability, one per map): register
 /// every pair `a < b` in parallel (`on_pair` is called after each, for a progress bar), solve
 /// one pose per map in the frame of map [`TeamConfig::reference`] from the accepted pairs
-/// (weighted by the walls they agree on, [`edge_weight`]), and fuse the maps that got a pose.
+/// (weighted by the walls they agree on, discounted by the wall lift), and fuse the maps that
+/// got a pose.
 ///
 /// The same maps and settings give the same result, whatever the thread count.
 pub fn merge_team(
