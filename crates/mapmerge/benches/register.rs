@@ -43,7 +43,7 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use grid_core::{CorrespondenceSource, OccupancyGrid};
-use mapmerge::ascent::{ascend, lone_wall_share, wall_thickness};
+use mapmerge::ascent::{ascend, frontier_ratio, lone_wall_share, wall_thickness};
 use mapmerge::global::{sweep_placements, twins};
 use mapmerge::search::local_search;
 use mapmerge::verify::{PreparedMap, VerifyConfig, verify};
@@ -156,9 +156,10 @@ fn bench(c: &mut Criterion) {
     g.bench_function("verify_one_placement", |bn| {
         bn.iter(|| verify(&ppa, &ppb, &start, &pair_config.verify))
     });
-    // The score ascent and its gate. The hard pair's walls are thin (0.87 and 0.57, below
-    // `AscentConfig::min_wall_thickness`), so `register` does not climb its answer; here the
-    // ascent runs from the sweep's first placement refined, as it would on thicker walls.
+    // The score ascent and its gates. The hard pair's walls are thin (0.87 and 0.57, below
+    // `AscentConfig::min_wall_thickness`) and its maps are a lidar's, so `register` does not
+    // climb its answer; here the ascent runs from the sweep's first placement refined, as it
+    // would on thicker walls.
     let ascent = pair_config.ascent.expect("the default climbs the answer");
     let refined = refine_and_score(&ppa, &ppb, &start, &pair_config.global_refine, pair_config).0;
     g.bench_function("score_ascent_one_answer", |bn| {
@@ -166,6 +167,11 @@ fn bench(c: &mut Criterion) {
     });
     g.bench_function("wall_thickness_both_maps", |bn| {
         bn.iter(|| (wall_thickness(&fa), wall_thickness(&fb)))
+    });
+    // The frontier ratios of the short-range rule (`ascent::ShortRange`), which `register`
+    // reads when an answer fits loosely on thin walls, as the hard pair's does.
+    g.bench_function("frontier_ratio_both_maps", |bn| {
+        bn.iter(|| rayon::join(|| frontier_ratio(&fa), || frontier_ratio(&fb)))
     });
     // The shares of lone wall cells that the clean-walls bar and the turn scan's gate read,
     // side by side as `register` scans them.

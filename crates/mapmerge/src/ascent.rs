@@ -150,22 +150,30 @@ pub fn wall_thickness(grid: &OccupancyGrid) -> f64 {
 /// wall.
 pub fn frontier_ratio(grid: &OccupancyGrid) -> f64 {
     let (w, h) = (grid.width(), grid.height());
-    let state = |x: usize, y: usize| grid.state(x, y);
+    let cells = grid.cells();
+    let row = |y: usize| &cells[y * w..][..w];
     let (mut frontier, mut beside_walls) = (0usize, 0usize);
+    // Row slices, as in `lone_wall_share`: most cells are not free and cost one test; a free
+    // cell's neighbours are read from its row and the rows above and below.
     for y in 0..h {
+        let (here, up, down) = (
+            row(y),
+            y.checked_sub(1).map(row),
+            (y + 1 < h).then(|| row(y + 1)),
+        );
         for x in 0..w {
-            if state(x, y) != CellState::Free {
+            if OccupancyGrid::classify(here[x]) != CellState::Free {
                 continue;
             }
             let neighbours = [
-                x.checked_sub(1).map(|x| (x, y)),
-                (x + 1 < w).then_some((x + 1, y)),
-                y.checked_sub(1).map(|y| (x, y)),
-                (y + 1 < h).then_some((x, y + 1)),
+                x.checked_sub(1).map(|x| here[x]),
+                here.get(x + 1).copied(),
+                up.map(|r| r[x]),
+                down.map(|r| r[x]),
             ];
             let (mut open, mut wall) = (false, false);
             for n in neighbours {
-                match n.map(|(x, y)| state(x, y)) {
+                match n.map(OccupancyGrid::classify) {
                     None | Some(CellState::Unknown) => open = true,
                     Some(CellState::Occupied) => wall = true,
                     Some(CellState::Free) => {}
