@@ -149,19 +149,11 @@ pub fn wall_thickness(grid: &OccupancyGrid) -> f64 {
 /// the end of their range, more often than on walls. 0 for a map without a free cell beside a
 /// wall.
 pub fn frontier_ratio(grid: &OccupancyGrid) -> f64 {
-    let (w, h) = (grid.width(), grid.height());
-    let cells = grid.cells();
-    let row = |y: usize| &cells[y * w..][..w];
     let (mut frontier, mut beside_walls) = (0usize, 0usize);
-    // Row slices, as in `lone_wall_share`: most cells are not free and cost one test; a free
-    // cell's neighbours are read from its row and the rows above and below.
-    for y in 0..h {
-        let (here, up, down) = (
-            row(y),
-            y.checked_sub(1).map(row),
-            (y + 1 < h).then(|| row(y + 1)),
-        );
-        for x in 0..w {
+    // A cell that is not free costs one test; a free cell's neighbours are read from its row
+    // and the rows above and below.
+    for (here, up, down) in rows_with_neighbours(grid) {
+        for x in 0..here.len() {
             if OccupancyGrid::classify(here[x]) != CellState::Free {
                 continue;
             }
@@ -196,19 +188,12 @@ pub fn frontier_ratio(grid: &OccupancyGrid) -> f64 {
 /// 0.09-0.21 at 20 %, 0.16-0.30 at 30 %, 0.28-0.46 at 50 %; docs/EVALUATION.md, "Equal noise
 /// of 20 %"), so two maps of alike sensors score alike. 0 for a map without occupied cells.
 pub fn lone_wall_share(grid: &OccupancyGrid) -> f64 {
-    let (w, h) = (grid.width(), grid.height());
-    let cells = grid.cells();
+    let w = grid.width();
     let occupied = |c: &u8| OccupancyGrid::classify(*c) == CellState::Occupied;
-    let row = |y: usize| &cells[y * w..][..w];
     let (mut walls, mut lone) = (0usize, 0usize);
-    // Row slices: the scan of the (mostly not occupied) cells is one test a cell, and an
-    // occupied cell's neighbours are three short slices.
-    for y in 0..h {
-        let (here, up, down) = (
-            row(y),
-            y.checked_sub(1).map(row),
-            (y + 1 < h).then(|| row(y + 1)),
-        );
+    // The scan of the (mostly not occupied) cells is one test a cell, and an occupied cell's
+    // neighbours are three short slices.
+    for (here, up, down) in rows_with_neighbours(grid) {
         for (x, c) in here.iter().enumerate() {
             if !occupied(c) {
                 continue;
@@ -229,6 +214,22 @@ pub fn lone_wall_share(grid: &OccupancyGrid) -> f64 {
     } else {
         lone as f64 / walls as f64
     }
+}
+
+/// Each row of `grid`'s cells, with the rows above and below it (`None` at the edges).
+fn rows_with_neighbours(
+    grid: &OccupancyGrid,
+) -> impl Iterator<Item = (&[u8], Option<&[u8]>, Option<&[u8]>)> {
+    let (w, h) = (grid.width(), grid.height());
+    let cells = grid.cells();
+    let row = move |y: usize| &cells[y * w..][..w];
+    (0..h).map(move |y| {
+        (
+            row(y),
+            y.checked_sub(1).map(row),
+            (y + 1 < h).then(|| row(y + 1)),
+        )
+    })
 }
 
 /// Climb the verification score, less the contradiction penalty
