@@ -36,21 +36,22 @@ pub struct AscentConfig {
     /// Moves at most (each tries six poses). Default 40.
     pub max_moves: usize,
     /// The ascent runs when both maps' walls are at least this thick ([`wall_thickness`]),
-    /// or on a short-range sensor's maps (`short_range`). Default 1.1. The default mapper of `mapsim` marks walls one cell
-    /// thick, often with unknown cells behind (0.66-0.85 on the 80 maps of the 30 % rows of
-    /// seed 7, `mapmerge info` on the maps `cargo xtask eval --export` writes), and a noisy
-    /// range sensor pushes them behind the obstacle faces by amounts that differ from map to
-    /// map: the score there peaks 3-5 px from the truth, and climbing it registered 3 more and
-    /// 18 fewer of the 120 pairs at 30 % overlap (seeds 7-9). Hector's model marks walls about
-    /// two cells thick and in place (1.25-1.76); the floors of `fixtures/maps` measure
-    /// 0.65-2.34 as drawn (docs/EVALUATION.md, "The score ascent"). A short-range sensor
-    /// with few beams also leaves one-cell walls, but little pushed: on mapsim's paper preset
-    /// (16-beam infrared rings, range 30 cells) at 30 % overlap the ascent without this gate
-    /// registered 50 instead of 45 of 63 pairs (seeds 7, 8, 9, 23), where the default
-    /// mapper's lidar rows at 30 % overlap lost 17 of 40 (seed 7) (docs/EVALUATION.md, "A
-    /// second held-out seed, and the score ascent on the paper's sensor"). The walls do not
-    /// tell the two sensors apart; the free space's frontiers do (`short_range`).
-    /// `mapmerge estimate|merge --climb` sets 0, for a user who knows the sensor.
+    /// or on a short-range sensor's maps (`short_range`). Default 1.1. The default mapper of
+    /// `mapsim` marks walls one cell thick, often with unknown cells behind (0.66-0.85 on the
+    /// 80 maps of the 30 % rows of seed 7, `mapmerge info` on the maps `cargo xtask eval
+    /// --export` writes), and a noisy range sensor pushes them behind the obstacle faces by
+    /// amounts that differ from map to map: the score there peaks 3-5 px from the truth, and
+    /// climbing it registered 3 more and 18 fewer of the 120 pairs at 30 % overlap (seeds
+    /// 7-9). Hector's model marks walls about two cells thick and in place (1.25-1.76); the
+    /// floors of `fixtures/maps` measure 0.65-2.34 as drawn (docs/EVALUATION.md, "The score
+    /// ascent"). A short-range sensor with few beams also leaves one-cell walls, but little
+    /// pushed: on mapsim's paper preset (16-beam infrared rings, range 30 cells) at 30 %
+    /// overlap the ascent without this gate registered 50 instead of 45 of 63 pairs (seeds 7,
+    /// 8, 9, 23), where the default mapper's lidar rows at 30 % overlap lost 17 of 40 (seed
+    /// 7; docs/EVALUATION.md, "A second held-out seed, and the score ascent on the paper's
+    /// sensor"). The walls do not tell the two sensors apart; the free space's frontiers do
+    /// (`short_range`). `mapmerge estimate|merge --climb` sets 0, for a user who knows the
+    /// sensor.
     pub min_wall_thickness: f64,
     /// When the ascent also runs on walls thinner than `min_wall_thickness`: on the maps of a
     /// short-range sensor ([`ShortRange`]). `None`: never. Default: on, [`ShortRange::default`].
