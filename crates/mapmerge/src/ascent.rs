@@ -96,8 +96,8 @@ pub struct ShortRange {
     /// Default 1.2. On the maps `cargo xtask eval --export` writes (the smaller of each
     /// pair's two), the default mapper's lidar maps at 10 % noise measure 0.76-1.04 in the
     /// simulated 30 % rows (seeds 7-9) and 0.65-1.19 on the real floors taken as worlds (10 %
-    /// and 20 % noise, seed 7), and the paper preset's 1.05-2.90 at 30 % overlap (60 of the 63 pairs of seeds 7, 8,
-    /// 9 and 23 at 1.2 or more) and 0.94-3.58 at half overlap.
+    /// and 20 % noise, seed 7), and the paper preset's 1.05-2.90 at 30 % overlap (60 of the
+    /// 63 pairs of seeds 7, 8, 9 and 23 at 1.2 or more) and 0.94-3.58 at half overlap.
     pub min_frontier_ratio: f64,
     /// The answer's wall lift ([`Verification::wall_lift`]) must be below this. Default 0.85.
     /// Walls that agree almost everywhere leave the score nothing to add but whole-cell
