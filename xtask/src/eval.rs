@@ -95,6 +95,11 @@ pub struct EvalArgs {
     /// what it changes.
     #[arg(long, value_parser = fraction::<f64>)]
     min_acceptance_index: Option<f64>,
+    /// Override the overlap in cells from which a placement passes
+    /// (`mapmerge::VerifyConfig::min_overlap_cells`; `0` turns the bar off; default: the
+    /// library's), to measure what it changes.
+    #[arg(long)]
+    min_overlap_cells: Option<usize>,
     /// Override the wide wall lift below which every clearly different placement that passes
     /// rivals the best (`mapmerge::VerifyConfig::trusted_wide_wall_lift`; `0` turns it off;
     /// default: the library's), to measure what it changes.
@@ -1009,6 +1014,7 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
     set(&mut verify.min_wall_lift, args.min_wall_lift);
     set(&mut verify.min_wide_wall_lift, args.min_wide_lift);
     set(&mut verify.min_acceptance_index, args.min_acceptance_index);
+    set(&mut verify.min_overlap_cells, args.min_overlap_cells);
     set(&mut verify.trusted_wide_wall_lift, args.trusted_wide_lift);
     set(
         &mut verify.max_contradiction_excess,

@@ -1535,6 +1535,15 @@ fn register_as_given(
             );
             return declined(reason, timings, candidates);
         }
+        if v.too_small(&config.verify) {
+            let reason = format!(
+                "too small: the best placement shares {} cells known in both maps, and at least {} are needed (it covers {:.0} % of the smaller map, which fits inside the other almost anywhere)",
+                v.overlap_cells,
+                config.verify.min_overlap_cells,
+                100.0 * v.overlap_fraction
+            );
+            return declined(reason, timings, candidates);
+        }
     }
     match candidates.first() {
         Some(best) if best.accepted => {

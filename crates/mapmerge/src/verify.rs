@@ -69,6 +69,20 @@ pub struct VerifyConfig {
     /// and 5), and 0.15 refuses them without losing a success (docs/EVALUATION.md, "Walls
     /// behind walls"). Lower it to merge maps that share only a corner.
     pub min_overlap_fraction: f64,
+    /// Minimum overlap of the answer in cells ([`Verification::overlap_cells`]), whatever its
+    /// fraction of the smaller map. Default 1 250 (about a 35-cell square). Applied to the
+    /// answer only, after the ambiguity test, as [`Self::small_overlap`]: a map that is little
+    /// more than a few laser streaks lies almost whole inside the other map wherever it is
+    /// put, so its fraction says nothing. Over every run kept from 2026-12-06/07 (`cargo
+    /// xtask eval` JSONL, 2 085 accepted answers within 3 px) each answer accepted with fewer
+    /// than 1 250 overlap cells was wrong (five real robots' map parts that share nothing,
+    /// placed 52-165 px off with 974-1 096 cells), and no candidate within 3 px of the truth
+    /// that passed the other bars had fewer than 1 428 (the paper's 150 x 150 preset at 30 %
+    /// overlap). As a bar on every placement it also took such placements out of the
+    /// ambiguity test, where they had declined as many wrong answers as it refused
+    /// (docs/EVALUATION.md, "Maps too small to tell"). Lower it for small maps at a fine
+    /// resolution.
+    pub min_overlap_cells: usize,
     /// A smaller overlap passes where the walls agree almost everywhere
     /// ([`CrispSliver`]): two parts of a clean building map that share a strip of rooms. `None`
     /// holds every placement to [`Self::min_overlap_fraction`].
@@ -299,6 +313,7 @@ impl Default for VerifyConfig {
             min_acceptance_index: 0.82,
             min_wall_support: 40,
             min_overlap_fraction: 0.15,
+            min_overlap_cells: 1_250,
             crisp_sliver: Some(CrispSliver::default()),
             small_overlap: Some(SmallOverlap::default()),
             max_ambiguity: 0.6,
@@ -988,6 +1003,12 @@ impl Verification {
             && (self.overlap_fraction >= config.min_overlap_fraction || crisp_sliver)
     }
 
+    /// Whether this placement, as the answer, shares fewer cells than
+    /// [`VerifyConfig::min_overlap_cells`].
+    pub fn too_small(&self, config: &VerifyConfig) -> bool {
+        self.overlap_cells < config.min_overlap_cells
+    }
+
     /// Where this placement's walls fit crisply (wall lift at least
     /// [`VerifyConfig::crisp_wall_lift`]), the [`Verification::mutual_contradiction`] above
     /// which it is declined as the answer: [`VerifyConfig::max_misfit_contradiction`] of the
@@ -1372,6 +1393,35 @@ mod tests {
         assert!(!small.falls_short(&v(0.24, 0.97)));
         // From a quarter on, any lift: the other bars judge it.
         assert!(!small.falls_short(&v(0.25, 0.3)));
+    }
+
+    #[test]
+    fn an_answer_of_too_few_cells_is_too_small_whatever_its_fraction() {
+        let config = VerifyConfig::default();
+        // A laser-streak part of a real robot's map laid inside the other map (case
+        // 8005012 of `cargo xtask eval --suites sensor --seed 8`): 86 % of the smaller map,
+        // walls that fit, but 1 002 cells. It passes every bar of a placement (and so still
+        // rivals others in the ambiguity test) but is too small as the answer.
+        let v = |overlap_cells: usize| Verification {
+            wall_lift: 0.73,
+            wide_wall_lift: 1.0,
+            wall_support: 248,
+            acceptance_index: 0.97,
+            overlap_fraction: 0.86,
+            overlap_cells,
+            ..Verification::default()
+        };
+        assert!(v(1_002).accepted(&config));
+        assert!(v(1_002).too_small(&config));
+        assert!(v(config.min_overlap_cells - 1).too_small(&config));
+        assert!(!v(config.min_overlap_cells).too_small(&config));
+        // The paper preset's smallest right answer at 30 % overlap.
+        assert!(!v(1_428).too_small(&config));
+        let off = VerifyConfig {
+            min_overlap_cells: 0,
+            ..config
+        };
+        assert!(!v(1_002).too_small(&off));
     }
 
     #[test]

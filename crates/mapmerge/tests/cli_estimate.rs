@@ -150,6 +150,45 @@ fn a_pair_that_shares_less_than_min_overlap_is_declined() {
     }
 }
 
+#[test]
+fn an_answer_on_fewer_cells_than_min_overlap_cells_is_declined_as_too_small() {
+    let (a, b) = (fixture("sunil_pair_a"), fixture("sunil_pair_b"));
+    let estimate = |min: &str| {
+        Command::new(env!("CARGO_BIN_EXE_mapmerge"))
+            .arg("estimate")
+            .args([&a, &b])
+            .args(["--json", "--min-overlap-cells", min])
+            .output()
+            .unwrap()
+    };
+    let out = estimate("1250");
+    let v = json(&out);
+    assert_eq!(out.status.code(), Some(0), "{v}");
+    let cells = v["verification"]["overlap_cells"].as_u64().unwrap();
+    assert!(cells > 1250, "{v}");
+    // One cell more than the answer shares: declined, the reason giving both numbers.
+    let out = estimate(&(cells + 1).to_string());
+    let v = json(&out);
+    assert_eq!(out.status.code(), Some(3), "{v}");
+    assert!(v["transform"].is_null());
+    assert!(
+        v["reason"].as_str().unwrap().starts_with(&format!(
+            "too small: the best placement shares {cells} cells known in both maps, and at least {} are needed",
+            cells + 1
+        )),
+        "{v}"
+    );
+    for bad in ["NaN", "-1", "1.5"] {
+        let e = fails(&[s(&a), s(&b), &format!("--min-overlap-cells={bad}")]);
+        assert!(
+            e.starts_with(&format!(
+                "mapmerge: error: invalid value '{bad}' for '--min-overlap-cells <CELLS>'"
+            )),
+            "{e}"
+        );
+    }
+}
+
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }

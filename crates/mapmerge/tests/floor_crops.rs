@@ -247,19 +247,55 @@ fn a_real_robots_partial_map_cut_in_two_is_registered() {
 /// a wall of the other: 15 % of the smaller part's known cells overlap, at wall lift 0.54,
 /// passing by the wide bar (0.84). Declined as a sliver (`mapmerge::verify::SmallOverlap`:
 /// under 25 % the walls must fit at a wide lift of 0.97), where without the rule it was
-/// answered 174 px off.
+/// answered 174 px off (with `VerifyConfig::min_overlap_cells` off too).
 #[test]
 fn a_real_robots_partial_map_cut_in_two_with_nothing_shared_is_declined_as_a_sliver() {
     let (pair, reason) = nothing_shared("tb_ctrl_room", 7_003_001);
     assert!(reason.starts_with("sliver: "), "{reason}");
     let mut without = RegisterConfig::default();
     without.pair.verify.small_overlap = None;
+    // Its 15 % are also under `VerifyConfig::min_overlap_cells` (since 2026-12-07): without
+    // the rule, that bar declines it.
+    let r = register(&pair.a, &pair.b, &without).unwrap();
+    let reason = r.reason.unwrap_or_default();
+    assert!(
+        r.accepted.is_none() && reason.starts_with("too small: "),
+        "{reason}"
+    );
+    without.pair.verify.min_overlap_cells = 0;
     let r = register(&pair.a, &pair.b, &without).unwrap();
     let c = r.accepted.expect("answered without the rule");
     let v = c.verification;
     assert!(
         v.overlap_fraction < 0.25 && v.wide_wall_lift < 0.97,
         "{v:?}"
+    );
+    let disp = displacement_error(&pair.b, &c.transform, &pair.truth).unwrap();
+    assert!(disp > 100.0, "{disp} px off");
+}
+
+/// Case 8005012 of `cargo xtask eval --suites sensor --seed 8`: the README's second real map
+/// cut in two with nothing shared, one part little more than a few laser streaks (about 1 000
+/// free cells). Laid inside the other part, it fits at wall lift 0.73 on 86 % of itself, but
+/// on 1 002 cells; declined as too small (`VerifyConfig::min_overlap_cells`), where without the
+/// bar it was answered about 160 px off.
+#[test]
+fn a_map_part_of_a_few_laser_streaks_is_declined_as_too_small() {
+    let (pair, reason) = nothing_shared("sunil_pair_b", 8_005_012);
+    assert!(
+        reason.starts_with("too small: the best placement shares 1002 cells"),
+        "{reason}"
+    );
+    let mut without = RegisterConfig::default();
+    without.pair.verify.min_overlap_cells = 0;
+    let c = register(&pair.a, &pair.b, &without)
+        .unwrap()
+        .accepted
+        .expect("answered without the bar");
+    assert!(
+        c.verification.overlap_fraction > 0.8,
+        "{:?}",
+        c.verification
     );
     let disp = displacement_error(&pair.b, &c.transform, &pair.truth).unwrap();
     assert!(disp > 100.0, "{disp} px off");

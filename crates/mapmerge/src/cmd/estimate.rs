@@ -26,7 +26,7 @@ Output (--json): one JSON object on stdout.
                    refinement fitted): 0 is what a random placement scores, 1 is perfect
                    agreement of the walls; pairs are accepted from 0.65 (or 0.8 with walls
                    compared at 4 px), with acceptance index >= 0.82 and an overlap of at
-                   least 15 % of the smaller map
+                   least 15 % of the smaller map and 1250 cells
   stands_out       true when no placement reached those bars and this one was accepted
                    because it stands out: lift at 4 px >= 0.7 over an overlap with walls in
                    it (wall_density >= 0.033 wall cells per cell), and every placement more

@@ -142,6 +142,12 @@ pub struct RegistrationArgs {
     /// where a few walls happen to line up
     #[arg(long, value_name = "FRACTION", value_parser = probability)]
     pub min_overlap: Option<f64>,
+    /// Cells that a placement must find known in both maps, whatever their share of the
+    /// smaller map [default: 1250, about a 35-cell square]. A map that is little more than a
+    /// few laser streaks fits inside the other almost anywhere; lower this for small maps at a
+    /// fine resolution
+    #[arg(long, value_name = "CELLS")]
+    pub min_overlap_cells: Option<usize>,
     /// Lift the bars that clean maps (few lone wall cells) are held to: an answer is declined
     /// when each map puts more than about 2 % of its walls in the other's free space (the
     /// reason says "where maps with walls this clean allow"), or when its walls fit the
@@ -184,6 +190,9 @@ impl RegistrationArgs {
             config.pair.verify.min_overlap_fraction = f;
             config.pair.verify.crisp_sliver = None;
             config.pair.verify.small_overlap = None;
+        }
+        if let Some(n) = self.min_overlap_cells {
+            config.pair.verify.min_overlap_cells = n;
         }
         config
     }
