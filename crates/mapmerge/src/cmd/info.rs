@@ -110,7 +110,16 @@ pub fn run(args: &InfoArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode> {
 fn human(i: &Info) -> String {
     let total = (i.width * i.height) as f64;
     let pct = |n: usize| 100.0 * n as f64 / total;
-    format!(
+    let known = i.free + i.occupied;
+    let min_cells = mapmerge::verify::VerifyConfig::default().min_overlap_cells;
+    let note = if known < min_cells {
+        format!(
+            "note:       only {known} known cells, fewer than the {min_cells} a registered pair must share (estimate|merge --min-overlap-cells): with the default settings no pair with this map is accepted\n"
+        )
+    } else {
+        String::new()
+    };
+    let text = format!(
         "map:        {path}\n\
          image:      {image} (mode {mode}, negate {negate}, occupied_thresh {occ}, free_thresh {free_t})\n\
          size:       {w} x {h} cells ({wm:.2} x {hm:.2} m)\n\
@@ -145,5 +154,6 @@ fn human(i: &Info) -> String {
         thick = i.wall_thickness,
         frontier = i.frontier_ratio,
         lone = 100.0 * i.lone_wall_share,
-    )
+    );
+    text + &note
 }
