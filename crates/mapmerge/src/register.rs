@@ -987,6 +987,21 @@ fn register_as_given(
         timings,
         matches: corrs.clone(),
     };
+    // A map with fewer known cells than an answer must share cannot be placed: said at once,
+    // rather than through whichever rule declines its placements.
+    let smaller = pa.known_cells.min(pb.known_cells);
+    if smaller < config.verify.min_overlap_cells {
+        let which = if pa.known_cells <= pb.known_cells {
+            "A"
+        } else {
+            "B"
+        };
+        let reason = format!(
+            "too small: map {which} has {smaller} known cells, fewer than the {} an answer must share with the other map",
+            config.verify.min_overlap_cells
+        );
+        return declined(reason, timings, Vec::new());
+    }
 
     let t0 = Instant::now();
     let ransac = estimate_rigid(&corrs, &config.ransac);

@@ -178,6 +178,26 @@ fn an_answer_on_fewer_cells_than_min_overlap_cells_is_declined_as_too_small() {
         )),
         "{v}"
     );
+    // A map with fewer known cells than the bar is declined at once, whichever side it is on:
+    // 30 x 30 cells, a wall along the top row, free space below.
+    let dir = std::env::temp_dir().join(format!("mapmerge-tiny-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let tiny = dir.join("tiny.pgm");
+    let mut bytes = b"P5\n30 30\n255\n".to_vec();
+    bytes.extend((0..900).map(|i| if i < 30 { 0u8 } else { 254 }));
+    std::fs::write(&tiny, bytes).unwrap();
+    for (x, y, which) in [(&tiny, &a, "A"), (&a, &tiny, "B")] {
+        let out = run(&[x, y]);
+        let v = json(&out);
+        assert_eq!(out.status.code(), Some(3), "{v}");
+        assert_eq!(
+            v["reason"],
+            format!(
+                "too small: map {which} has 900 known cells, fewer than the 1250 an answer must share with the other map"
+            )
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
     for bad in ["NaN", "-1", "1.5"] {
         let e = fails(&[s(&a), s(&b), &format!("--min-overlap-cells={bad}")]);
         assert!(

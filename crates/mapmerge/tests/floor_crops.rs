@@ -277,13 +277,24 @@ fn a_real_robots_partial_map_cut_in_two_with_nothing_shared_is_declined_as_a_sli
 /// Case 8005012 of `cargo xtask eval --suites sensor --seed 8`: the README's second real map
 /// cut in two with nothing shared, one part little more than a few laser streaks (about 1 000
 /// free cells). Laid inside the other part, it fits at wall lift 0.73 on 86 % of itself, but
-/// on 1 002 cells; declined as too small (`VerifyConfig::min_overlap_cells`), where without the
-/// bar it was answered about 160 px off.
+/// on 1 002 cells; declined as too small (`VerifyConfig::min_overlap_cells`): the part has
+/// fewer known cells than the bar, which the decline says at once. With the bar at 1 100 the
+/// part may be placed, and the answer is declined for its 1 002 cells; without the bar it was
+/// answered about 160 px off.
 #[test]
 fn a_map_part_of_a_few_laser_streaks_is_declined_as_too_small() {
     let (pair, reason) = nothing_shared("sunil_pair_b", 8_005_012);
+    assert_eq!(
+        reason,
+        "too small: map A has 1169 known cells, fewer than the 1250 an answer must share with the other map"
+    );
+    let mut lower = RegisterConfig::default();
+    lower.pair.verify.min_overlap_cells = 1_100;
+    let r = register(&pair.a, &pair.b, &lower).unwrap();
+    let reason = r.reason.unwrap_or_default();
     assert!(
-        reason.starts_with("too small: the best placement shares 1002 cells"),
+        r.accepted.is_none()
+            && reason.starts_with("too small: the best placement shares 1002 cells known in both maps, and at least 1100 are needed"),
         "{reason}"
     );
     let mut without = RegisterConfig::default();
