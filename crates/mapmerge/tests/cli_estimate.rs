@@ -11,7 +11,7 @@ use grid_core::{CellState, DVec2, OccupancyGrid, Rigid2};
 use tempfile::TempDir;
 
 mod common;
-use common::fixture;
+use common::{estimate_json, fixture, tiny_map};
 
 fn run(args: &[&Path]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_mapmerge"))
@@ -117,14 +117,7 @@ fn unrelated_maps_are_declined_with_exit_3() {
 fn a_pair_that_shares_less_than_min_overlap_is_declined() {
     // The real pair shares 38.9 % of the smaller map's known cells.
     let (a, b) = (fixture("sunil_pair_a"), fixture("sunil_pair_b"));
-    let estimate = |min: &str| {
-        Command::new(env!("CARGO_BIN_EXE_mapmerge"))
-            .arg("estimate")
-            .args([&a, &b])
-            .args(["--json", "--min-overlap", min])
-            .output()
-            .unwrap()
-    };
+    let estimate = |min: &str| estimate_json(&a, &b, &["--min-overlap", min]);
     let out = estimate("0.35");
     assert_eq!(out.status.code(), Some(0));
     let out = estimate("0.45");
@@ -153,14 +146,7 @@ fn a_pair_that_shares_less_than_min_overlap_is_declined() {
 #[test]
 fn an_answer_on_fewer_cells_than_min_overlap_cells_is_declined_as_too_small() {
     let (a, b) = (fixture("sunil_pair_a"), fixture("sunil_pair_b"));
-    let estimate = |min: &str| {
-        Command::new(env!("CARGO_BIN_EXE_mapmerge"))
-            .arg("estimate")
-            .args([&a, &b])
-            .args(["--json", "--min-overlap-cells", min])
-            .output()
-            .unwrap()
-    };
+    let estimate = |min: &str| estimate_json(&a, &b, &["--min-overlap-cells", min]);
     let out = estimate("1250");
     let v = json(&out);
     assert_eq!(out.status.code(), Some(0), "{v}");
@@ -179,13 +165,9 @@ fn an_answer_on_fewer_cells_than_min_overlap_cells_is_declined_as_too_small() {
         "{v}"
     );
     // A map with fewer known cells than the bar is declined at once, whichever side it is on:
-    // 30 x 30 cells, a wall along the top row, free space below.
-    let dir = std::env::temp_dir().join(format!("mapmerge-tiny-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let tiny = dir.join("tiny.pgm");
-    let mut bytes = b"P5\n30 30\n255\n".to_vec();
-    bytes.extend((0..900).map(|i| if i < 30 { 0u8 } else { 254 }));
-    std::fs::write(&tiny, bytes).unwrap();
+    // 900 known cells.
+    let dir = TempDir::new().unwrap();
+    let tiny = tiny_map(dir.path());
     for (x, y, which) in [(&tiny, &a, "A"), (&a, &tiny, "B")] {
         let out = run(&[x, y]);
         let v = json(&out);
@@ -197,7 +179,6 @@ fn an_answer_on_fewer_cells_than_min_overlap_cells_is_declined_as_too_small() {
             )
         );
     }
-    std::fs::remove_dir_all(&dir).unwrap();
     for bad in ["NaN", "-1", "1.5"] {
         let e = fails(&[s(&a), s(&b), &format!("--min-overlap-cells={bad}")]);
         assert!(

@@ -9,7 +9,7 @@ use std::path::PathBuf;
 use serde_json::{Value, json};
 
 mod common;
-use common::mapmerge;
+use common::{mapmerge, tiny_map};
 
 fn fixture(name: &str, ext: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -277,14 +277,10 @@ fn info_human_form() {
 
 #[test]
 fn a_map_smaller_than_any_accepted_overlap_is_noted() {
-    // 30 x 30 cells, a wall along the top row and free space below: 900 known cells, under
-    // the 1 250 a registered pair must share (`VerifyConfig::min_overlap_cells`).
-    let dir = std::env::temp_dir().join(format!("mapmerge-info-tiny-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let pgm = dir.join("tiny.pgm");
-    let mut bytes = b"P5\n30 30\n255\n".to_vec();
-    bytes.extend((0..900).map(|i| if i < 30 { 0u8 } else { 254 }));
-    std::fs::write(&pgm, bytes).unwrap();
+    // 900 known cells, under the 1 250 a registered pair must share
+    // (`VerifyConfig::min_overlap_cells`).
+    let dir = tempfile::TempDir::new().unwrap();
+    let pgm = tiny_map(dir.path());
     let out = mapmerge(&["info", pgm.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(0));
     let text = String::from_utf8(out.stdout).unwrap();
@@ -298,7 +294,6 @@ fn a_map_smaller_than_any_accepted_overlap_is_noted() {
     let yaml = fixture("wpi_ilab", "yaml");
     let out = mapmerge(&["info", yaml.to_str().unwrap()]);
     assert!(!String::from_utf8(out.stdout).unwrap().contains("note:"));
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]

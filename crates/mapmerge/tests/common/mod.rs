@@ -2,7 +2,7 @@
 //! of them.
 #![allow(dead_code)]
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use grid_core::Rigid2;
@@ -40,4 +40,25 @@ pub fn transform(v: &serde_json::Value) -> Rigid2 {
         v["tx"].as_f64().unwrap(),
         v["ty"].as_f64().unwrap(),
     )
+}
+
+/// Write `tiny.pgm` into `dir`: a 30 x 30 bare PGM map, a wall along the top row and free
+/// space below, 900 known cells (fewer than the 1 250 a registered pair must share).
+pub fn tiny_map(dir: &Path) -> PathBuf {
+    let pgm = dir.join("tiny.pgm");
+    let mut bytes = b"P5\n30 30\n255\n".to_vec();
+    bytes.extend((0..900).map(|i| if i < 30 { 0u8 } else { 254 }));
+    std::fs::write(&pgm, bytes).unwrap();
+    pgm
+}
+
+/// Run `mapmerge estimate A B --json` with `flags`.
+pub fn estimate_json(a: &Path, b: &Path, flags: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_mapmerge"))
+        .arg("estimate")
+        .args([a, b])
+        .arg("--json")
+        .args(flags)
+        .output()
+        .unwrap()
 }
