@@ -95,7 +95,7 @@ pub struct EvalArgs {
     /// what it changes.
     #[arg(long, value_parser = fraction::<f64>)]
     min_acceptance_index: Option<f64>,
-    /// Override the overlap in cells from which a placement passes
+    /// Override the overlap in cells from which an answer passes
     /// (`mapmerge::VerifyConfig::min_overlap_cells`; `0` turns the bar off; default: the
     /// library's), to measure what it changes.
     #[arg(long)]

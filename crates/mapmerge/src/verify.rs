@@ -76,12 +76,12 @@ pub struct VerifyConfig {
     /// put, so its fraction says nothing. Over every run kept from 2026-12-06/07 (`cargo
     /// xtask eval` JSONL, 2 085 accepted answers within 3 px) each answer accepted with fewer
     /// than 1 250 overlap cells was wrong (five real robots' map parts that share nothing,
-    /// placed 52-165 px off with 974-1 096 cells), and no candidate within 3 px of the truth
+    /// placed 57-165 px off with 974-1 096 cells), and no candidate within 3 px of the truth
     /// that passed the other bars had fewer than 1 428 (the paper's 150 x 150 preset at 30 %
     /// overlap). As a bar on every placement it also took such placements out of the
-    /// ambiguity test, where they had declined as many wrong answers as it refused
-    /// (docs/EVALUATION.md, "Maps too small to tell"). Lower it for small maps at a fine
-    /// resolution.
+    /// ambiguity test, where they had kept six other wrong answers out (docs/EVALUATION.md,
+    /// "Maps too small to tell"). A map with fewer known cells than this is declined before
+    /// any search. Lower it for small maps at a fine resolution.
     pub min_overlap_cells: usize,
     /// A smaller overlap passes where the walls agree almost everywhere
     /// ([`CrispSliver`]): two parts of a clean building map that share a strip of rooms. `None`

@@ -254,8 +254,8 @@ fn a_real_robots_partial_map_cut_in_two_with_nothing_shared_is_declined_as_a_sli
     assert!(reason.starts_with("sliver: "), "{reason}");
     let mut without = RegisterConfig::default();
     without.pair.verify.small_overlap = None;
-    // Its 15 % are also under `VerifyConfig::min_overlap_cells` (since 2026-12-07): without
-    // the rule, that bar declines it.
+    // That placement's overlap is also under `VerifyConfig::min_overlap_cells` (since
+    // 2026-12-07): without the rule, that bar declines it.
     let r = register(&pair.a, &pair.b, &without).unwrap();
     let reason = r.reason.unwrap_or_default();
     assert!(

@@ -142,10 +142,10 @@ pub struct RegistrationArgs {
     /// where a few walls happen to line up
     #[arg(long, value_name = "FRACTION", value_parser = probability)]
     pub min_overlap: Option<f64>,
-    /// Cells that a placement must find known in both maps, whatever their share of the
-    /// smaller map [default: 1250, about a 35-cell square]. A map that is little more than a
-    /// few laser streaks fits inside the other almost anywhere; lower this for small maps at a
-    /// fine resolution
+    /// Cells that the answer must find known in both maps, whatever their share of the
+    /// smaller map [default: 1250, about a 35-cell square]; a map with fewer known cells is
+    /// declined at once. A map that is little more than a few laser streaks fits inside the
+    /// other almost anywhere; lower this for small maps at a fine resolution
     #[arg(long, value_name = "CELLS")]
     pub min_overlap_cells: Option<usize>,
     /// Lift the bars that clean maps (few lone wall cells) are held to: an answer is declined
