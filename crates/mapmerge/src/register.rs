@@ -989,13 +989,12 @@ fn register_as_given(
     };
     // A map with fewer known cells than an answer must share cannot be placed: said at once,
     // rather than through whichever rule declines its placements.
-    let smaller = pa.known_cells.min(pb.known_cells);
+    let (which, smaller) = if pa.known_cells <= pb.known_cells {
+        ("A", pa.known_cells)
+    } else {
+        ("B", pb.known_cells)
+    };
     if smaller < config.verify.min_overlap_cells {
-        let which = if pa.known_cells <= pb.known_cells {
-            "A"
-        } else {
-            "B"
-        };
         let reason = format!(
             "too small: map {which} has {smaller} known cells, fewer than the {} an answer must share with the other map",
             config.verify.min_overlap_cells
