@@ -400,6 +400,15 @@ pub struct EvalArgs {
     /// ones.
     #[arg(long, value_parser = noise_value)]
     noise_first: Option<f64>,
+    /// Every robot's maximum range, in cells, instead of each row's own (robot rows only; the
+    /// labels say so; the suites' lidars reach 80): to measure registration on a sensor that
+    /// sees less or farther than the one the settings were chosen on.
+    #[arg(long, value_name = "CELLS", value_parser = max_range_value)]
+    max_range: Option<f64>,
+    /// Every robot's beam count, spread over a full turn, instead of each row's own (robot
+    /// rows only; the labels say so; the suites' lidars have 360): a sparser or denser scan.
+    #[arg(long, value_name = "N", value_parser = beams_value)]
+    beams: Option<usize>,
     /// Bend the second part of every `crops` pair by this angle at each end, in degrees
     /// (`mapsim::CropConfig::bend_deg`: a map built with a drifting heading), against the
     /// unbent truth; the labels say so. The displacement error then includes the bend itself,
@@ -551,6 +560,22 @@ fn noise_value(s: &str) -> Result<f64, String> {
     match s.parse::<f64>() {
         Ok(b) if (0.0..1.0).contains(&b) => Ok(b),
         _ => Err(format!("expected a noise bound in [0, 1), got {s:?}")),
+    }
+}
+
+/// A maximum range in cells: a finite number from 5 to 1000.
+fn max_range_value(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(r) if (5.0..=1000.0).contains(&r) => Ok(r),
+        _ => Err(format!("expected a range from 5 to 1000 cells, got {s:?}")),
+    }
+}
+
+/// A beam count: a whole number from 4 to 10,000.
+fn beams_value(s: &str) -> Result<usize, String> {
+    match s.parse::<usize>() {
+        Ok(n) if (4..=10_000).contains(&n) => Ok(n),
+        _ => Err(format!("expected a beam count from 4 to 10000, got {s:?}")),
     }
 }
 
@@ -1532,11 +1557,12 @@ fn write_crops(pair: &mapsim::CropPair, seed: u64, label: &str, dir: &Path) -> R
     Ok(())
 }
 
-/// Run `cargo xtask eval`.
-pub fn run(args: EvalArgs) -> Result<()> {
-    let mut rows = rows(&args.suites, args.size, args.mapper)?;
+/// The flags that change the rows' maps rather than the registration (`--noise`,
+/// `--noise-first`, `--max-range`, `--beams`, `--bend`, `--keep-walls`), each applied to the
+/// rows it concerns and named in their labels.
+fn override_rows(rows: &mut [Row], args: &EvalArgs) {
     if let Some(noise) = args.noise {
-        for row in &mut rows {
+        for row in rows.iter_mut() {
             if let Source::Robots(config) = &mut row.source {
                 for robot in &mut config.robots {
                     robot.noise_bound = noise;
@@ -1546,7 +1572,7 @@ pub fn run(args: EvalArgs) -> Result<()> {
         }
     }
     if let Some(noise) = args.noise_first {
-        for row in &mut rows {
+        for row in rows.iter_mut() {
             if let Source::Robots(config) = &mut row.source
                 && let Some(first) = config.robots.first_mut()
             {
@@ -1555,8 +1581,29 @@ pub fn run(args: EvalArgs) -> Result<()> {
             }
         }
     }
+    if let Some(range) = args.max_range {
+        for row in rows.iter_mut() {
+            if let Source::Robots(config) = &mut row.source {
+                for robot in &mut config.robots {
+                    robot.max_range = range;
+                }
+                row.label = format!("{}, every range set to {range} cells", row.label);
+            }
+        }
+    }
+    if let Some(beams) = args.beams {
+        for row in rows.iter_mut() {
+            if let Source::Robots(config) = &mut row.source {
+                for robot in &mut config.robots {
+                    robot.beams = beams;
+                    robot.failed_beams.retain(|&i| i < beams);
+                }
+                row.label = format!("{}, every sensor set to {beams} beams", row.label);
+            }
+        }
+    }
     if let Some(bend) = args.bend {
-        for row in &mut rows {
+        for row in rows.iter_mut() {
             if let Source::Crops(_, config) = &mut row.source {
                 config.bend_deg = bend;
                 row.label = format!("{}, second part bent {bend} deg", row.label);
@@ -1564,7 +1611,7 @@ pub fn run(args: EvalArgs) -> Result<()> {
         }
     }
     if let Some(keep) = args.keep_walls {
-        for row in &mut rows {
+        for row in rows.iter_mut() {
             if let Source::Crops(_, config) = &mut row.source {
                 config.keep_walls = keep;
                 row.label = format!(
@@ -1575,6 +1622,12 @@ pub fn run(args: EvalArgs) -> Result<()> {
             }
         }
     }
+}
+
+/// Run `cargo xtask eval`.
+pub fn run(args: EvalArgs) -> Result<()> {
+    let mut rows = rows(&args.suites, args.size, args.mapper)?;
+    override_rows(&mut rows, &args);
     let defaults = register_config(&args);
     // Settings the flags' parsers let through but the library refuses (a grid size of 0)
     // stop the run here, once, instead of failing every case.
@@ -1936,6 +1989,7 @@ mod tests {
             "--search-free-penalty",
             "--refine-tolerance",
             "--noise",
+            "--max-range",
             "--bend",
         ];
         for flag in flags {
@@ -1961,6 +2015,60 @@ mod tests {
         // Out of range.
         assert!(parse("--min-wall-lift", "1.5").is_err());
         assert!(parse("--search-sigma", "0").is_err());
+    }
+
+    #[test]
+    fn sensor_overrides_set_every_robot_of_the_robot_rows_and_name_it_in_their_labels() {
+        let args = Cli::try_parse_from([
+            "eval",
+            "--suites",
+            "overlap,paper,crops",
+            "--max-range",
+            "40",
+            "--beams",
+            "180",
+        ])
+        .unwrap()
+        .args;
+        let mut rows = super::rows(&args.suites, args.size, args.mapper).unwrap();
+        super::override_rows(&mut rows, &args);
+        let (mut robot_rows, mut crop_rows) = (0, 0);
+        for row in &rows {
+            match &row.source {
+                Source::Robots(config) => {
+                    robot_rows += 1;
+                    assert_eq!(config.robots.len(), 2, "{}", row.label);
+                    for robot in &config.robots {
+                        assert_eq!(robot.max_range, 40.0, "{}", row.label);
+                        assert_eq!(robot.beams, 180, "{}", row.label);
+                    }
+                    assert!(
+                        row.label.ends_with(
+                            ", every range set to 40 cells, every sensor set to 180 beams"
+                        ),
+                        "{}",
+                        row.label
+                    );
+                }
+                Source::Crops(..) => {
+                    crop_rows += 1;
+                    assert!(!row.label.contains("every"), "{}", row.label);
+                }
+            }
+        }
+        // The overlap suite's six rows and the paper's two; the crops' ten have no sensor.
+        assert_eq!((robot_rows, crop_rows), (8, 10));
+        // Out of range.
+        let parse =
+            |flag: &str, value: &str| Cli::try_parse_from(["eval", flag, value]).map(|c| c.args);
+        for bad in ["4.9", "1001", "inf", "-40"] {
+            assert!(parse("--max-range", bad).is_err(), "{bad}");
+        }
+        for bad in ["3", "10001", "1.5", "x"] {
+            assert!(parse("--beams", bad).is_err(), "{bad}");
+        }
+        assert_eq!(parse("--max-range", "5").unwrap().max_range, Some(5.0));
+        assert_eq!(parse("--beams", "4").unwrap().beams, Some(4));
     }
 
     #[test]
