@@ -6,7 +6,8 @@
 //! from its walls at right angles (`ManhattanRotation`), the score ascent
 //! (`PairConfig::ascent`), the angle scanned about the overlap (`PairConfig::turn_scan`), that
 //! the answer does not depend on the maps' unknown border
-//! (`PairConfig::frame_margin`), and a pair drawn by a mapper no setting was chosen on.
+//! (`PairConfig::frame_margin`), a pair drawn by a mapper no setting was chosen on, and how
+//! the push of noisy walls grows with the sensor's range.
 
 use grid_core::metrics::displacement_error;
 use grid_core::{DVec2, OccupancyGrid};
@@ -30,6 +31,22 @@ fn simulated_case(
     noise: f64,
     model: InverseSensorModel,
 ) -> Case {
+    let robot = RobotConfig {
+        noise_bound: noise,
+        ..RobotConfig::default()
+    };
+    robots_case(kind, seed, overlap, robot, model)
+}
+
+/// As [`simulated_case`], both robots carrying `robot`'s sensor (`cargo xtask eval
+/// --max-range`, `--beams` and `--noise` set it so).
+fn robots_case(
+    kind: WorldKind,
+    seed: u64,
+    overlap: f64,
+    robot: RobotConfig,
+    model: InverseSensorModel,
+) -> Case {
     let config = CaseConfig {
         world: WorldConfig {
             kind,
@@ -37,13 +54,7 @@ fn simulated_case(
             height: 400,
             ..WorldConfig::default()
         },
-        robots: vec![
-            RobotConfig {
-                noise_bound: noise,
-                ..RobotConfig::default()
-            };
-            2
-        ],
+        robots: vec![robot; 2],
         overlap,
         overlap_tolerance: f64::INFINITY,
         inverse_model: model,
@@ -237,6 +248,60 @@ fn thin_walls_pushed_by_range_noise_are_not_climbed() {
     registered_only_with(&disaster_30(8_000_008), "the thickness gate", |c| {
         c.pair.ascent.as_mut().unwrap().min_wall_thickness = 0.0;
     });
+}
+
+/// Where the known cells of `map` lie on average.
+fn known_centroid(map: &OccupancyGrid) -> DVec2 {
+    let (mut sum, mut n) = (DVec2::ZERO, 0.0);
+    for y in 0..map.height() {
+        for x in 0..map.width() {
+            if map.state(x, y) != grid_core::CellState::Unknown {
+                sum += DVec2::new(x as f64, y as f64);
+                n += 1.0;
+            }
+        }
+    }
+    sum / n
+}
+
+/// Case 7_000_004 of the disaster 30 % overlap row (`cargo xtask eval --suites overlap --seed
+/// 7`), both robots at 10 % range noise, drawn with lidars of three ranges (`--max-range`):
+/// the farther the sensor reads, the farther each map's walls are pushed behind the obstacle
+/// faces, and the farther apart the answer puts the maps (docs/EVALUATION.md, "The sensor's
+/// range decides the push"). The answers lie 0.55, 2.70 and 8.24 px off, B's known cells
+/// -0.1, +2.7 and +8.2 px farther from A's than at the truth: within 1 px at 40 cells, within
+/// 3 px at the suites' 80, and at 150 accepted well off, pushed apart.
+#[test]
+fn the_push_grows_with_the_sensors_range() {
+    let mut pushes = Vec::new();
+    for (range, most_px) in [(40.0, 1.0), (80.0, 3.0), (150.0, f64::INFINITY)] {
+        let robot = RobotConfig {
+            max_range: range,
+            noise_bound: 0.1,
+            ..RobotConfig::default()
+        };
+        let case = robots_case(
+            WorldKind::Disaster,
+            7_000_004,
+            0.3,
+            robot,
+            InverseSensorModel::default(),
+        );
+        let (r, error) = registered(&case, &RegisterConfig::default());
+        let error = error.unwrap_or_else(|| panic!("range {range}: declined: {:?}", r.reason));
+        assert!(error <= most_px, "range {range}: {error} px off");
+        // How much farther from A's known cells the answer puts B's than the truth does.
+        let (a, b) = (&case.robots[0].map, &case.robots[1].map);
+        let (ca, cb) = (known_centroid(a), known_centroid(b));
+        let answer = r.accepted.unwrap().transform;
+        let push = (answer.apply(cb) - ca).length() - (case.truth(0, 1).apply(cb) - ca).length();
+        pushes.push((range, error, push));
+    }
+    let [(_, e40, p40), (_, e80, p80), (_, e150, p150)] = pushes[..] else {
+        unreachable!()
+    };
+    assert!(e40 < e80 && e80 < e150, "{pushes:?}");
+    assert!(p40.abs() < 1.0 && p80 > 1.5 && p150 > 6.0, "{pushes:?}");
 }
 
 /// Case 8001019 of `cargo xtask eval --suites paper --only "overlap 0.3" --seed 8` (the
