@@ -250,20 +250,6 @@ fn thin_walls_pushed_by_range_noise_are_not_climbed() {
     });
 }
 
-/// Where the known cells of `map` lie on average.
-fn known_centroid(map: &OccupancyGrid) -> DVec2 {
-    let (mut sum, mut n) = (DVec2::ZERO, 0.0);
-    for y in 0..map.height() {
-        for x in 0..map.width() {
-            if map.state(x, y) != grid_core::CellState::Unknown {
-                sum += DVec2::new(x as f64, y as f64);
-                n += 1.0;
-            }
-        }
-    }
-    sum / n
-}
-
 /// Case 7_000_004 of the disaster 30 % overlap row (`cargo xtask eval --suites overlap --seed
 /// 7`), both robots at 10 % range noise, drawn with lidars of three ranges (`--max-range`):
 /// the farther the sensor reads, the farther each map's walls are pushed behind the obstacle
@@ -292,7 +278,7 @@ fn the_push_grows_with_the_sensors_range() {
         assert!(error <= most_px, "range {range}: {error} px off");
         // How much farther from A's known cells the answer puts B's than the truth does.
         let (a, b) = (&case.robots[0].map, &case.robots[1].map);
-        let (ca, cb) = (known_centroid(a), known_centroid(b));
+        let (ca, cb) = (a.known_centroid().unwrap(), b.known_centroid().unwrap());
         let answer = r.accepted.unwrap().transform;
         let push = (answer.apply(cb) - ca).length() - (case.truth(0, 1).apply(cb) - ca).length();
         pushes.push((range, error, push));

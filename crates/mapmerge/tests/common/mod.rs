@@ -54,11 +54,6 @@ pub fn tiny_map(dir: &Path) -> PathBuf {
 
 /// Run `mapmerge estimate A B --json` with `flags`.
 pub fn estimate_json(a: &Path, b: &Path, flags: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_mapmerge"))
-        .arg("estimate")
-        .args([a, b])
-        .arg("--json")
-        .args(flags)
-        .output()
-        .unwrap()
+    let (a, b) = (a.to_str().unwrap(), b.to_str().unwrap());
+    mapmerge(&[&["estimate", a, b, "--json"], flags].concat())
 }
