@@ -387,8 +387,9 @@ pub struct EvalArgs {
     refine_tolerance: Option<f64>,
     /// How the simulated robots fold their beams into their maps (`default`; `hector`: gentle
     /// clearing, so noisy walls stay as speckle; `octomap`: OctoMap's probabilities, never
-    /// tuned on; see `cargo xtask gen --help`). Row labels name a mapper other than the
-    /// default.
+    /// tuned on; `gmapping` and `slam-toolbox`: the hit counts of GMapping and of Karto in
+    /// slam_toolbox, never tuned on; see `cargo xtask gen --help`). Row labels name a mapper
+    /// other than the default.
     #[arg(long, value_enum, default_value = "default")]
     mapper: Mapper,
     /// Every robot's range noise bound, as a fraction (e.g. 0.05), instead of each row's own
@@ -971,7 +972,7 @@ fn rows(suites: &[String], size: usize, mapper: Mapper) -> Result<Vec<Row>> {
     if mapper != Mapper::Default {
         for row in &mut rows {
             if let Source::Robots(config) = &mut row.source {
-                config.inverse_model = mapper.model();
+                config.mapper = mapper.model();
                 row.label = format!("{}, {} mapper", row.label, mapper.name());
             }
         }

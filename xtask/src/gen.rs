@@ -9,7 +9,9 @@ use clap::ValueEnum;
 use grid_core::{CellState, DVec2, GridGeometry, Pose2};
 use image::{Rgb, RgbImage};
 use indicatif::{ProgressBar, ProgressStyle};
-use mapsim::{Case, CaseConfig, InverseSensorModel, WorldKind, generate_case};
+use mapsim::{
+    Case, CaseConfig, HitRatioModel, InverseSensorModel, MapperModel, WorldKind, generate_case,
+};
 use serde_json::json;
 
 /// Base settings a case starts from before the individual flags apply.
@@ -23,8 +25,7 @@ pub enum Preset {
     Indoor,
 }
 
-/// The robots' mapper: how beams are folded into each log-odds grid
-/// (`mapsim::InverseSensorModel`).
+/// The robots' mapper: how beams are folded into each grid (`mapsim::MapperModel`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
 pub enum Mapper {
     /// mapsim's default: a pass adds log-odds -1.4, a hit 2.2. Clears hard: under strong range
@@ -39,15 +40,24 @@ pub enum Mapper {
     /// clamped at 3.5. A hit outweighs two passes, but a cell hit once and passed once reads
     /// unknown: under strong noise walls fade about as with the default.
     Octomap,
+    /// GMapping's (`occ_thresh` 0.25): hit and pass counts per cell, occupied when more than a
+    /// quarter of the beams that reached a cell ended in it. A noisy wall stays as a band.
+    Gmapping,
+    /// Karto's, the mapper of ROS 2's slam_toolbox (`occupancy_threshold` 0.1,
+    /// `min_pass_through` 2): occupied when more than a tenth of the beams that reached a cell
+    /// ended in it, known once three beams reached it. A noisy wall stays as a wide band.
+    SlamToolbox,
 }
 
 impl Mapper {
-    /// The inverse sensor model this mapper uses.
-    pub fn model(self) -> InverseSensorModel {
+    /// The model this mapper folds beams with.
+    pub fn model(self) -> MapperModel {
         match self {
-            Mapper::Default => InverseSensorModel::default(),
-            Mapper::Hector => InverseSensorModel::hector(),
-            Mapper::Octomap => InverseSensorModel::octomap(),
+            Mapper::Default => InverseSensorModel::default().into(),
+            Mapper::Hector => InverseSensorModel::hector().into(),
+            Mapper::Octomap => InverseSensorModel::octomap().into(),
+            Mapper::Gmapping => HitRatioModel::gmapping().into(),
+            Mapper::SlamToolbox => HitRatioModel::slam_toolbox().into(),
         }
     }
 
@@ -159,7 +169,7 @@ fn config(args: &Args) -> Result<CaseConfig> {
     if let Some(o) = args.overlap {
         c.overlap = o;
     }
-    c.inverse_model = args.mapper.model();
+    c.mapper = args.mapper.model();
     if let Some(path) = &args.world {
         let grid = grid_core::io::load_map(path, &grid_core::io::LoadOptions::default())
             .with_context(|| format!("--world {}", path.display()))?;

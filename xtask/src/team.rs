@@ -162,7 +162,7 @@ pub fn run(args: Args) -> Result<()> {
                 robots: vec![RobotConfig::default(); *n],
                 overlap: args.overlap,
                 overlap_tolerance: f64::INFINITY,
-                inverse_model: args.mapper.model(),
+                mapper: args.mapper.model(),
                 ..CaseConfig::default()
             };
             bar.inc(1);

@@ -57,7 +57,7 @@ fn robots_case(
         robots: vec![robot; 2],
         overlap,
         overlap_tolerance: f64::INFINITY,
-        inverse_model: model,
+        mapper: model.into(),
         ..CaseConfig::default()
     };
     generate_case(&config, seed).unwrap()

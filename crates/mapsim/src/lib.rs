@@ -25,7 +25,9 @@
 //! the band, so walls settle near `r (1 + b)`: pushed away from the robot by about `b r` cells,
 //! differently in each robot's map. At 30-50 % a beam that reads long passes through thin
 //! rubble, and with the default [`InverseSensorModel`] most obstacles disappear from the map;
-//! a mapper that clears gently ([`InverseSensorModel::hector`]) keeps them as bands of speckle.
+//! a mapper that clears gently ([`InverseSensorModel::hector`]) keeps them as bands of speckle,
+//! and so do the counting mappers of GMapping and slam_toolbox ([`HitRatioModel`]), which keep
+//! a cell occupied wherever a quarter (a tenth) of the beams that reached it ended in it.
 //! Real mappers do one or the other; registration has to live with both (see
 //! `docs/EVALUATION.md`).
 //!
@@ -166,9 +168,9 @@ pub struct CaseConfig {
     pub clearance: f64,
     /// Spacing of the exploration waypoints in cells; `None` = 0.8 x the smallest max range.
     pub waypoint_spacing: Option<f64>,
-    /// How every robot's mapper folds beams into its log-odds grid. Default
-    /// [`InverseSensorModel::default`].
-    pub inverse_model: InverseSensorModel,
+    /// How every robot's mapper folds beams into its grid: log-odds or hit counts. Default
+    /// [`InverseSensorModel::default`], log-odds.
+    pub mapper: MapperModel,
 }
 
 /// The mapper's inverse sensor model: the log-odds added to a cell a beam passes through
@@ -228,6 +230,74 @@ impl InverseSensorModel {
     }
 }
 
+/// A counting mapper: every cell keeps how many beams reached it (its passes, the beams that
+/// ended in it included) and how many ended in it (its hits), and reads occupied when more
+/// than `occupied_above` of its passes were hits, free otherwise, and unknown until more than
+/// `min_passes` beams reached it. The published map holds no probabilities, only occupied,
+/// free and unknown.
+///
+/// This is how GMapping (`occ_thresh`, [`Self::gmapping`]) and Karto, the mapper of ROS 2's
+/// slam_toolbox (`occupancy_threshold` and `min_pass_through`, [`Self::slam_toolbox`]), build
+/// the maps they publish. Nothing is clamped, so a wall is kept wherever one beam in four (or
+/// in ten) ends on it: under range noise a wall stays as a band, like hector's speckle,
+/// rather than being cleared as by [`InverseSensorModel::default`].
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct HitRatioModel {
+    /// Hits per pass above which a cell is occupied, in `(0, 1)`.
+    pub occupied_above: f32,
+    /// Passes a cell needs beyond this count to be known.
+    pub min_passes: u32,
+}
+
+impl HitRatioModel {
+    /// GMapping's defaults (`slam_gmapping`'s `occ_thresh` 0.25): occupied when more than a
+    /// quarter of the beams that reached a cell ended in it, known once one beam reached it.
+    pub fn gmapping() -> Self {
+        Self {
+            occupied_above: 0.25,
+            min_passes: 0,
+        }
+    }
+
+    /// Karto's defaults in slam_toolbox (`occupancy_threshold` 0.1, `min_pass_through` 2):
+    /// occupied when more than a tenth of the beams that reached a cell ended in it, known
+    /// once three beams reached it.
+    pub fn slam_toolbox() -> Self {
+        Self {
+            occupied_above: 0.1,
+            min_passes: 2,
+        }
+    }
+}
+
+/// How a robot folds its beams into its map.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum MapperModel {
+    /// Log-odds per cell, clamped, published as a probability (mapsim's default, hector,
+    /// OctoMap).
+    LogOdds(InverseSensorModel),
+    /// Hit and pass counts per cell, published as occupied, free or unknown (GMapping, Karto).
+    HitRatio(HitRatioModel),
+}
+
+impl Default for MapperModel {
+    fn default() -> Self {
+        Self::LogOdds(InverseSensorModel::default())
+    }
+}
+
+impl From<InverseSensorModel> for MapperModel {
+    fn from(m: InverseSensorModel) -> Self {
+        Self::LogOdds(m)
+    }
+}
+
+impl From<HitRatioModel> for MapperModel {
+    fn from(m: HitRatioModel) -> Self {
+        Self::HitRatio(m)
+    }
+}
+
 impl Default for CaseConfig {
     fn default() -> Self {
         Self {
@@ -241,7 +311,7 @@ impl Default for CaseConfig {
             pose_step: 2.0,
             clearance: 3.0,
             waypoint_spacing: None,
-            inverse_model: InverseSensorModel::default(),
+            mapper: MapperModel::default(),
         }
     }
 }
@@ -346,18 +416,29 @@ impl CaseConfig {
         {
             return bad(format!("waypoint_spacing {s} (need >= 2)"));
         }
-        let m = &self.inverse_model;
-        let valid = m.free.is_finite()
-            && m.free < 0.0
-            && m.occupied.is_finite()
-            && m.occupied > 0.0
-            && m.clamp.is_finite()
-            && m.clamp > 0.0;
-        if !valid {
-            return bad(format!(
-                "inverse_model free {} occupied {} clamp {} (need free < 0 < occupied, clamp > 0)",
-                m.free, m.occupied, m.clamp
-            ));
+        match &self.mapper {
+            MapperModel::LogOdds(m) => {
+                let valid = m.free.is_finite()
+                    && m.free < 0.0
+                    && m.occupied.is_finite()
+                    && m.occupied > 0.0
+                    && m.clamp.is_finite()
+                    && m.clamp > 0.0;
+                if !valid {
+                    return bad(format!(
+                        "inverse_model free {} occupied {} clamp {} (need free < 0 < occupied, clamp > 0)",
+                        m.free, m.occupied, m.clamp
+                    ));
+                }
+            }
+            MapperModel::HitRatio(m) => {
+                if !(m.occupied_above > 0.0 && m.occupied_above < 1.0) {
+                    return bad(format!(
+                        "hit ratio model occupied_above {} (need 0 < occupied_above < 1)",
+                        m.occupied_above
+                    ));
+                }
+            }
         }
         Ok(())
     }

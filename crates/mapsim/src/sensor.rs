@@ -11,7 +11,7 @@ use rayon::prelude::*;
 use crate::planner::PathPose;
 use crate::raycast::{cast, traverse};
 use crate::world::World;
-use crate::{CaseConfig, Result, RobotConfig};
+use crate::{CaseConfig, MapperModel, Result, RobotConfig};
 
 /// One measured beam, in world pixels.
 #[derive(Debug, Clone, Copy)]
@@ -143,9 +143,68 @@ pub(crate) fn build_map(
     let (w, h) = (size.x as usize + 1, size.y as usize + 1);
     let world_to_map = Rigid2::new(theta, t.x, t.y);
 
-    let model = case.inverse_model;
-    let mut logodds = vec![0f32; w * h];
-    let mut seen = vec![false; w * h];
+    let cells = match case.mapper {
+        MapperModel::LogOdds(model) => {
+            let mut logodds = vec![0f32; w * h];
+            let mut seen = vec![false; w * h];
+            fold_beams(rays, (&world_to_map, rot), (w, h), |i, hit| {
+                logodds[i] = if hit {
+                    (logodds[i] + model.occupied).min(model.clamp)
+                } else {
+                    (logodds[i] + model.free).max(-model.clamp)
+                };
+                seen[i] = true;
+            });
+            logodds
+                .iter()
+                .zip(&seen)
+                .map(|(&l, &s)| {
+                    if s {
+                        (100.0 / (1.0 + (-l).exp())).round() as u8
+                    } else {
+                        UNKNOWN
+                    }
+                })
+                .collect()
+        }
+        MapperModel::HitRatio(model) => {
+            // (hits, passes), a hit counting as a pass.
+            let mut counts = vec![(0u32, 0u32); w * h];
+            fold_beams(rays, (&world_to_map, rot), (w, h), |i, hit| {
+                let c = &mut counts[i];
+                c.0 += u32::from(hit);
+                c.1 += 1;
+            });
+            counts
+                .iter()
+                .map(|&(hits, passes)| {
+                    if passes <= model.min_passes {
+                        UNKNOWN
+                    } else if hits as f32 > model.occupied_above * passes as f32 {
+                        100
+                    } else {
+                        0
+                    }
+                })
+                .collect()
+        }
+    };
+    let map = OccupancyGrid::from_cells(w, h, resolution, Pose2::default(), cells)?;
+    Ok((map, world_to_map.inverse()))
+}
+
+/// Every beam of `rays` rasterised in the map (`world_to_map`, whose rotation is `rot`, onto a
+/// `w x h` canvas): `update(i,
+/// false)` for each cell `i` it passes through, then `update(i, true)` for the cell it ends in
+/// when it returned an obstacle. A cell is passed when its centre projects before the
+/// measured end, and the first cell whose centre projects beyond it is the hit: walls come out
+/// one cell thick, on the obstacle boundary, independent of the map's rotation.
+fn fold_beams(
+    rays: &[Ray],
+    (world_to_map, rot): (&Rigid2, DVec2),
+    (w, h): (usize, usize),
+    mut update: impl FnMut(usize, bool),
+) {
     let idx = |x: i64, y: i64| {
         (x >= 0 && y >= 0 && (x as usize) < w && (y as usize) < h)
             .then(|| y as usize * w + x as usize)
@@ -154,9 +213,6 @@ pub(crate) fn build_map(
         let o = world_to_map.apply(r.origin);
         let d = rot.rotate(r.dir);
         let mut occ_done = !r.hit;
-        // A cell is free when its centre projects before the measured end, and the first cell
-        // whose centre projects beyond it is the hit: walls come out one cell thick, on the
-        // obstacle boundary, independent of the map's rotation.
         let reach = if r.hit { r.len + 1.5 } else { r.len };
         traverse(o, d, reach, |x, y, _| {
             let s = (DVec2::new(x as f64, y as f64) - o).dot(d);
@@ -164,12 +220,10 @@ pub(crate) fn build_map(
                 return true;
             };
             if s < r.len {
-                logodds[i] = (logodds[i] + model.free).max(-model.clamp);
-                seen[i] = true;
+                update(i, false);
                 true
             } else if !occ_done {
-                logodds[i] = (logodds[i] + model.occupied).min(model.clamp);
-                seen[i] = true;
+                update(i, true);
                 occ_done = true;
                 false
             } else {
@@ -177,17 +231,4 @@ pub(crate) fn build_map(
             }
         });
     }
-    let cells = logodds
-        .iter()
-        .zip(&seen)
-        .map(|(&l, &s)| {
-            if s {
-                (100.0 / (1.0 + (-l).exp())).round() as u8
-            } else {
-                UNKNOWN
-            }
-        })
-        .collect();
-    let map = OccupancyGrid::from_cells(w, h, resolution, Pose2::default(), cells)?;
-    Ok((map, world_to_map.inverse()))
 }
