@@ -15,8 +15,10 @@ use crate::eval::{self, EvalArgs};
 #[command(after_help = "\
 Sets (20 cases per row, as in docs/EVALUATION.md):
   o30     the overlap suite's 30 % rows, seeds 7, 8, 9     o30h    the same, hector's mapper
+  o30g    the same, GMapping's mapper                     o30s    the same, slam_toolbox's
   real    the real floors, seeds 7, 8, 9                  realh   hector's, seeds 8, 9
   zero    every must-decline row, seeds 1, 2, 3, 7        zeroh   hector's, the same seeds
+                                                          zeros   slam_toolbox's, the same
   ovl     every overlap row, seed 7                       ovlh    hector's, seed 7
   large   the nav2 warehouse, seeds 7, 8                  largeh  hector's, seed 8
   floors  five real floors at 30 % overlap, seeds 7, 8
@@ -24,8 +26,10 @@ Sets (20 cases per row, as in docs/EVALUATION.md):
   crops   the same floors cut in two, sharing 30 % or nothing (must decline), seed 7
   sensor  three real robots' partial maps cut in two the same way, seeds 7, 8, 9
 The batch without `sensor` (2,100 cases) took 18 minutes on a 2-core Intel Xeon VM
-(2026-12-06, 02:09-02:27 UTC); `sensor` (360 cases) takes about a minute more. `cargo
-xtask calibrate DIR` then tabulates its answers' errors by confidence.
+(2026-12-06, 02:09-02:27 UTC); `sensor` (360 cases) takes about a minute more, and the
+counting mappers' sets `o30g`, `o30s` and `zeros` (2026-12-07; 520 cases) about three on
+the 2-core AMD EPYC VM. `cargo xtask calibrate DIR` then tabulates its answers' errors by
+confidence.
 
 Examples:
   cargo xtask regress --out /tmp/before
@@ -48,7 +52,8 @@ struct Set {
     name: &'static str,
     suites: &'static str,
     only: Option<&'static str>,
-    hector: bool,
+    /// `--mapper` of its runs (`None`: the default).
+    mapper: Option<&'static str>,
     seeds: &'static [u64],
 }
 
@@ -57,98 +62,119 @@ const SETS: &[Set] = &[
         name: "o30",
         suites: "overlap",
         only: Some("overlap 0.3"),
-        hector: false,
+        mapper: None,
         seeds: &[7, 8, 9],
     },
     Set {
         name: "o30h",
         suites: "overlap",
         only: Some("overlap 0.3"),
-        hector: true,
+        mapper: Some("hector"),
+        seeds: &[7, 8, 9],
+    },
+    Set {
+        name: "o30g",
+        suites: "overlap",
+        only: Some("overlap 0.3"),
+        mapper: Some("gmapping"),
+        seeds: &[7, 8, 9],
+    },
+    Set {
+        name: "o30s",
+        suites: "overlap",
+        only: Some("overlap 0.3"),
+        mapper: Some("slam-toolbox"),
         seeds: &[7, 8, 9],
     },
     Set {
         name: "real",
         suites: "real",
         only: None,
-        hector: false,
+        mapper: None,
         seeds: &[7, 8, 9],
     },
     Set {
         name: "realh",
         suites: "real",
         only: None,
-        hector: true,
+        mapper: Some("hector"),
         seeds: &[8, 9],
     },
     Set {
         name: "zero",
         suites: "zero,noise",
         only: Some("must decline"),
-        hector: false,
+        mapper: None,
         seeds: &[1, 2, 3, 7],
     },
     Set {
         name: "zeroh",
         suites: "zero,noise",
         only: Some("must decline"),
-        hector: true,
+        mapper: Some("hector"),
+        seeds: &[1, 2, 3, 7],
+    },
+    Set {
+        name: "zeros",
+        suites: "zero,noise",
+        only: Some("must decline"),
+        mapper: Some("slam-toolbox"),
         seeds: &[1, 2, 3, 7],
     },
     Set {
         name: "ovl",
         suites: "overlap",
         only: None,
-        hector: false,
+        mapper: None,
         seeds: &[7],
     },
     Set {
         name: "ovlh",
         suites: "overlap",
         only: None,
-        hector: true,
+        mapper: Some("hector"),
         seeds: &[7],
     },
     Set {
         name: "large",
         suites: "large",
         only: None,
-        hector: false,
+        mapper: None,
         seeds: &[7, 8],
     },
     Set {
         name: "largeh",
         suites: "large",
         only: None,
-        hector: true,
+        mapper: Some("hector"),
         seeds: &[8],
     },
     Set {
         name: "floors",
         suites: "floors",
         only: None,
-        hector: false,
+        mapper: None,
         seeds: &[7, 8],
     },
     Set {
         name: "floorzero",
         suites: "floorzero",
         only: None,
-        hector: false,
+        mapper: None,
         seeds: &[7],
     },
     Set {
         name: "crops",
         suites: "crops",
         only: None,
-        hector: false,
+        mapper: None,
         seeds: &[7],
     },
     Set {
         name: "sensor",
         suites: "sensor",
         only: None,
-        hector: false,
+        mapper: None,
         seeds: &[7, 8, 9],
     },
 ];
@@ -187,8 +213,8 @@ fn plan(
             if let Some(only) = set.only {
                 argv.extend(["--only".into(), only.into()]);
             }
-            if set.hector {
-                argv.extend(["--mapper".into(), "hector".into()]);
+            if let Some(mapper) = set.mapper {
+                argv.extend(["--mapper".into(), mapper.into()]);
             }
             argv.extend([
                 "--out".into(),
@@ -259,6 +285,12 @@ mod tests {
                 "o30h_7",
                 "o30h_8",
                 "o30h_9",
+                "o30g_7",
+                "o30g_8",
+                "o30g_9",
+                "o30s_7",
+                "o30s_8",
+                "o30s_9",
                 "real_7",
                 "real_8",
                 "real_9",
@@ -272,6 +304,10 @@ mod tests {
                 "zeroh_2",
                 "zeroh_3",
                 "zeroh_7",
+                "zeros_1",
+                "zeros_2",
+                "zeros_3",
+                "zeros_7",
                 "ovl_7",
                 "ovlh_7",
                 "large_7",
