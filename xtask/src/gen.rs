@@ -41,11 +41,13 @@ pub enum Mapper {
     /// unknown: under strong noise walls fade about as with the default.
     Octomap,
     /// GMapping's (`occ_thresh` 0.25): hit and pass counts per cell, occupied when more than a
-    /// quarter of the beams that reached a cell ended in it. A noisy wall stays as a band.
+    /// quarter of the beams that reached a cell ended in it. Of a noisy wall's band the last
+    /// few cells stay, behind the wall's face as with the default.
     Gmapping,
     /// Karto's, the mapper of ROS 2's slam_toolbox (`occupancy_threshold` 0.1,
     /// `min_pass_through` 2): occupied when more than a tenth of the beams that reached a cell
-    /// ended in it, known once three beams reached it. A noisy wall stays as a wide band.
+    /// ended in it, known once three beams reached it. A noisy wall stays as a wide band over
+    /// its face.
     SlamToolbox,
 }
 

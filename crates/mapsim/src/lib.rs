@@ -26,8 +26,9 @@
 //! differently in each robot's map. At 30-50 % a beam that reads long passes through thin
 //! rubble, and with the default [`InverseSensorModel`] most obstacles disappear from the map;
 //! a mapper that clears gently ([`InverseSensorModel::hector`]) keeps them as bands of speckle,
-//! and so do the counting mappers of GMapping and slam_toolbox ([`HitRatioModel`]), which keep
-//! a cell occupied wherever a quarter (a tenth) of the beams that reached it ended in it.
+//! and the counting mappers of GMapping and slam_toolbox ([`HitRatioModel`]), which keep a
+//! cell occupied wherever a quarter (a tenth) of the beams that reached it ended in it, keep
+//! the far end of each band (a wide band over the obstacle's face).
 //! Real mappers do one or the other; registration has to live with both (see
 //! `docs/EVALUATION.md`).
 //!
@@ -238,9 +239,11 @@ impl InverseSensorModel {
 ///
 /// This is how GMapping (`occ_thresh`, [`Self::gmapping`]) and Karto, the mapper of ROS 2's
 /// slam_toolbox (`occupancy_threshold` and `min_pass_through`, [`Self::slam_toolbox`]), build
-/// the maps they publish. Nothing is clamped, so a wall is kept wherever one beam in four (or
-/// in ten) ends on it: under range noise a wall stays as a band, like hector's speckle,
-/// rather than being cleared as by [`InverseSensorModel::default`].
+/// the maps they publish. Nothing is clamped. Under range noise a cell of a wall's band is hit
+/// by about one beam in `2 b r` and passed by those that read beyond it, so the cells that
+/// stay occupied are the band's last few: about 3 under GMapping's quarter, which sit behind
+/// the wall's face as [`InverseSensorModel::default`]'s do, and about 9 under Karto's tenth,
+/// a band over the face (docs/EVALUATION.md, "The maps of GMapping and slam_toolbox").
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct HitRatioModel {
     /// Hits per pass above which a cell is occupied, in `(0, 1)`.
