@@ -279,6 +279,7 @@ pub(crate) fn write_case(case: &Case, preset: &str, dir: &Path) -> Result<()> {
             "pose_step": c.pose_step,
             "clearance": c.clearance,
             "waypoint_spacing": c.waypoint_spacing,
+            "mapper": mapper_json(&c.mapper),
         },
         "robots": robots,
         "pairs": pairs,
@@ -292,6 +293,23 @@ pub(crate) fn write_case(case: &Case, preset: &str, dir: &Path) -> Result<()> {
         .context("encoding preview.png")?;
     grid_core::io::write_atomic(&dir.join("preview.png"), &png)?;
     Ok(())
+}
+
+/// The mapper of a case as truth.json records it, its numbers as written in the source (an
+/// `f32` widened to `f64` would print as 0.10000000149011612).
+fn mapper_json(mapper: &MapperModel) -> serde_json::Value {
+    let number = |v: f32| v.to_string().parse::<f64>().unwrap_or(f64::from(v));
+    match mapper {
+        MapperModel::LogOdds(m) => json!({"log_odds": {
+            "free": number(m.free),
+            "occupied": number(m.occupied),
+            "clamp": number(m.clamp),
+        }}),
+        MapperModel::HitRatio(m) => json!({"hit_ratio": {
+            "occupied_above": number(m.occupied_above),
+            "min_passes": m.min_passes,
+        }}),
+    }
 }
 
 const COLOURS: [[u8; 3]; 6] = [

@@ -156,6 +156,31 @@ fn a_real_map_is_the_world() {
 }
 
 #[test]
+fn the_mapper_is_recorded_in_the_truth() {
+    let dir = tempfile::tempdir().unwrap();
+    gen_into(
+        dir.path(),
+        &["--preset", "paper", "--mapper", "slam-toolbox"],
+    );
+    let truth: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("case_0/truth.json")).unwrap())
+            .unwrap();
+    assert_eq!(
+        truth["config"]["mapper"],
+        serde_json::json!({"hit_ratio": {"occupied_above": 0.1, "min_passes": 2}})
+    );
+    let dir = tempfile::tempdir().unwrap();
+    gen_into(dir.path(), &["--preset", "paper"]);
+    let truth: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("case_0/truth.json")).unwrap())
+            .unwrap();
+    assert_eq!(
+        truth["config"]["mapper"],
+        serde_json::json!({"log_odds": {"free": -1.4, "occupied": 2.2, "clamp": 5.0}})
+    );
+}
+
+#[test]
 fn a_missing_world_map_is_named_in_the_error() {
     let dir = tempfile::tempdir().unwrap();
     let missing = dir.path().join("nowhere.yaml");
