@@ -557,7 +557,7 @@ where
 }
 
 /// `--noise B`: a noise bound in [0, 1).
-fn noise_value(s: &str) -> Result<f64, String> {
+pub(crate) fn noise_value(s: &str) -> Result<f64, String> {
     match s.parse::<f64>() {
         Ok(b) if (0.0..1.0).contains(&b) => Ok(b),
         _ => Err(format!("expected a noise bound in [0, 1), got {s:?}")),
