@@ -1,9 +1,9 @@
 //! `cargo xtask team`: how well `mapmerge merge` places every map of a simulated robot team.
 //!
 //! Each case is a mapsim team of 3 or 4 lidar robots (mapsim's default sensor: 360 beams,
-//! range 80 cells, 2 % range noise unless `--noise` says otherwise) whose consecutive robots' explored areas
-//! overlap by the requested fraction (robots further apart in the tour may share little or
-//! nothing). Every map is merged into the first map's frame with
+//! range 80 cells, 2 % range noise unless `--noise` says otherwise) whose consecutive robots'
+//! explored areas overlap by the requested fraction (robots further apart in the tour may share
+//! little or nothing). Every map is merged into the first map's frame with
 //! `mapmerge::team::merge_team`, and each map's pose is judged against the truth as a pair's
 //! answer is: placed within 3 px (mean displacement over its known cells) or not. Two ways of
 //! placing the maps are reported from the same registrations: the pose graph (`merge_team`'s

@@ -244,7 +244,7 @@ impl InverseSensorModel {
 /// stay occupied are the band's last few: about 3 under GMapping's quarter, which sit behind
 /// the wall's face as [`InverseSensorModel::default`]'s do, and about 9 under Karto's tenth,
 /// a band over the face (docs/EVALUATION.md, "The maps of GMapping and slam_toolbox").
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HitRatioModel {
     /// Hits per pass above which a cell is occupied, in `(0, 1)`.
     pub occupied_above: f32,

@@ -194,9 +194,8 @@ pub(crate) fn build_map(
 }
 
 /// Every beam of `rays` rasterised in the map (`world_to_map`, whose rotation is `rot`, onto a
-/// `w x h` canvas): `update(i,
-/// false)` for each cell `i` it passes through, then `update(i, true)` for the cell it ends in
-/// when it returned an obstacle. A cell is passed when its centre projects before the
+/// `w x h` canvas): `update(i, false)` for each cell `i` it passes through, then `update(i,
+/// true)` for the cell it ends in when it returned an obstacle. A cell is passed when its centre projects before the
 /// measured end, and the first cell whose centre projects beyond it is the hit: walls come out
 /// one cell thick, on the obstacle boundary, independent of the map's rotation.
 fn fold_beams(
