@@ -1001,6 +1001,25 @@ fn register_as_given(
         );
         return declined(reason, timings, Vec::new());
     }
+    // Walls are what a placement is judged by: a map without one, or two maps with fewer wall
+    // cells together than an answer must compare, cannot be placed. Said at once, rather than
+    // as "no transform hypothesis" after the samplers have drawn in vain.
+    let (walls_a, walls_b) = (pa.occupied_cells, pb.occupied_cells);
+    if walls_a == 0 || walls_b == 0 {
+        let which = if walls_a == 0 { "A" } else { "B" };
+        let reason = format!(
+            "no walls: map {which} has no occupied cell, and walls are what a placement is judged by"
+        );
+        return declined(reason, timings, Vec::new());
+    }
+    if walls_a + walls_b < config.verify.min_wall_support {
+        let reason = format!(
+            "too few walls: the maps have {} occupied cells together, fewer than the {} an answer must compare",
+            walls_a + walls_b,
+            config.verify.min_wall_support
+        );
+        return declined(reason, timings, Vec::new());
+    }
 
     let t0 = Instant::now();
     let ransac = estimate_rigid(&corrs, &config.ransac);

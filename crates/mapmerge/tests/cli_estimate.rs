@@ -190,6 +190,47 @@ fn an_answer_on_fewer_cells_than_min_overlap_cells_is_declined_as_too_small() {
     }
 }
 
+/// A 50 x 50 map, free but for `walls` occupied cells along its first row.
+fn sparse_walls_map(dir: &Path, name: &str, walls: usize) -> PathBuf {
+    let pgm = dir.join(name);
+    let mut bytes = b"P5\n50 50\n255\n".to_vec();
+    bytes.extend((0..2500).map(|i| if i < walls { 0u8 } else { 254 }));
+    std::fs::write(&pgm, bytes).unwrap();
+    pgm
+}
+
+#[test]
+fn maps_without_enough_walls_are_declined_and_told_so() {
+    let dir = TempDir::new().unwrap();
+    let a = fixture("sunil_pair_a");
+    // Known cells enough (2,500 of the 1,250 an answer must share), but not one wall.
+    let free = sparse_walls_map(dir.path(), "free.pgm", 0);
+    for (x, y, which) in [(&free, &a, "A"), (&a, &free, "B")] {
+        let out = run(&[x, y]);
+        let v = json(&out);
+        assert_eq!(out.status.code(), Some(3), "{v}");
+        assert!(v["transform"].is_null());
+        assert_eq!(
+            v["reason"],
+            format!(
+                "no walls: map {which} has no occupied cell, and walls are what a placement is judged by"
+            )
+        );
+    }
+    // 3 and 30 wall cells: 33 together, under the 40 an answer must compare.
+    let (few, some) = (
+        sparse_walls_map(dir.path(), "few.pgm", 3),
+        sparse_walls_map(dir.path(), "some.pgm", 30),
+    );
+    let out = run(&[&few, &some]);
+    let v = json(&out);
+    assert_eq!(out.status.code(), Some(3), "{v}");
+    assert_eq!(
+        v["reason"],
+        "too few walls: the maps have 33 occupied cells together, fewer than the 40 an answer must compare"
+    );
+}
+
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }

@@ -276,7 +276,7 @@ fn info_human_form() {
 }
 
 #[test]
-fn a_map_smaller_than_any_accepted_overlap_is_noted() {
+fn a_map_no_pair_can_be_accepted_with_is_noted() {
     // 900 known cells, under the 1 250 a registered pair must share
     // (`VerifyConfig::min_overlap_cells`).
     let dir = tempfile::TempDir::new().unwrap();
@@ -287,6 +287,20 @@ fn a_map_smaller_than_any_accepted_overlap_is_noted() {
     assert!(
         text.ends_with(
             "note:       only 900 known cells, fewer than the 1250 a registered pair must share (estimate|merge --min-overlap-cells): with the default settings no pair with this map is accepted\n"
+        ),
+        "{text}"
+    );
+    // A map with known cells enough but no wall gets its own note.
+    let free = dir.path().join("free.pgm");
+    let mut bytes = b"P5\n50 50\n255\n".to_vec();
+    bytes.extend([254u8; 2500]);
+    std::fs::write(&free, bytes).unwrap();
+    let out = mapmerge(&["info", free.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0));
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        text.ends_with(
+            "note:       no occupied cell: walls are what a placement is judged by, so no pair with this map is accepted\n"
         ),
         "{text}"
     );

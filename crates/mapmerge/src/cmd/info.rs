@@ -116,6 +116,8 @@ fn human(i: &Info) -> String {
         format!(
             "note:       only {known} known cells, fewer than the {min_cells} a registered pair must share (estimate|merge --min-overlap-cells): with the default settings no pair with this map is accepted\n"
         )
+    } else if i.occupied == 0 {
+        "note:       no occupied cell: walls are what a placement is judged by, so no pair with this map is accepted\n".to_string()
     } else {
         String::new()
     };
