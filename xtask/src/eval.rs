@@ -80,6 +80,12 @@ pub struct EvalArgs {
     /// library's), to measure what it changes.
     #[arg(long, value_parser = fraction::<f64>)]
     max_contradiction_excess: Option<f64>,
+    /// Override the excess of wall in free space a rival of a best that puts none there may
+    /// have (`mapmerge::VerifyConfig::clean_contradiction_excess`; 0.05, the
+    /// `max_contradiction_excess`, is the rule before 2026-12-07; default: the library's), to
+    /// measure what it changes.
+    #[arg(long, value_parser = fraction::<f64>)]
+    clean_contradiction_excess: Option<f64>,
     /// Override the wall lift from which a placement passes the wall bar
     /// (`mapmerge::VerifyConfig::min_wall_lift`; default: the library's), to measure what it
     /// changes.
@@ -1046,6 +1052,10 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
         &mut verify.max_contradiction_excess,
         args.max_contradiction_excess,
     );
+    set(
+        &mut verify.clean_contradiction_excess,
+        args.clean_contradiction_excess,
+    );
     if let Some(CleanWallsArg(c)) = args.clean_walls {
         verify.clean_walls = c;
     }
@@ -1954,6 +1964,7 @@ mod tests {
             "--wall-tolerance",
             "--basin-ratio",
             "--max-contradiction-excess",
+            "--clean-contradiction-excess",
             "--min-wall-lift",
             "--min-wide-lift",
             "--trusted-wide-lift",

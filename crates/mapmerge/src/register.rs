@@ -677,7 +677,8 @@ impl KindTotals {
 /// that makes the pair ambiguous ([`VerifyConfig::max_ambiguity`]): it passes, scores almost
 /// as well or fits its (smaller) overlap at least as well, or the best itself fits below
 /// [`VerifyConfig::trusted_wide_wall_lift`], and it does not put clearly more walls into the
-/// other map's free space ([`VerifyConfig::max_contradiction_excess`]).
+/// other map's free space ([`VerifyConfig::max_contradiction_excess`]; less is clearly more
+/// when the best puts few there, [`VerifyConfig::clean_contradiction_excess`]).
 ///
 /// A twin from the symmetry probes is judged by the same rule. At 9c48d15 every twin that
 /// passed was a rival, which declined exact copies of small rooms whose quarter-turned twin
@@ -687,7 +688,15 @@ fn rivals(best: &Verification, c: &Candidate, config: &VerifyConfig) -> bool {
     c.accepted
         && (fits_about_as_well(best, v, config)
             || best.wide_wall_lift < config.trusted_wide_wall_lift)
-        && v.wall_contradiction <= best.wall_contradiction + config.max_contradiction_excess
+        && v.wall_contradiction <= best.wall_contradiction + contradiction_excess(best, config)
+}
+
+/// How much more of its walls than `best` a placement may put into the other map's free space
+/// and still rival it: [`VerifyConfig::clean_contradiction_excess`] plus the best's own
+/// share, at most [`VerifyConfig::max_contradiction_excess`].
+fn contradiction_excess(best: &Verification, config: &VerifyConfig) -> f64 {
+    (config.clean_contradiction_excess + best.wall_contradiction.max(0.0))
+        .min(config.max_contradiction_excess)
 }
 
 /// Whether `v` scores almost as well as `best` ([`VerifyConfig::max_ambiguity`]) or fits its
@@ -1935,10 +1944,26 @@ mod tests {
         let best = scores(1.0, 622, 0.0);
         assert!(!rivals(&best, &twin(scores(0.90, 292, 0.027)), &config));
         // Scoring 0.6 of the best, or fitting as well, makes it a rival ...
-        assert!(rivals(&best, &twin(scores(0.90, 430, 0.027)), &config));
+        assert!(rivals(&best, &twin(scores(0.90, 430, 0.015)), &config));
         assert!(rivals(&best, &twin(scores(1.0, 200, 0.0)), &config));
-        // ... unless it puts more than 0.05 more of its walls into free space, or fails.
+        // ... unless it puts clearly more of its walls into free space: against a best that
+        // puts none there, more than 0.02 ...
+        assert!(!rivals(&best, &twin(scores(0.90, 430, 0.027)), &config));
         assert!(!rivals(&best, &twin(scores(1.0, 622, 0.06)), &config));
+        // ... (the rule before, 0.05 whatever the best, at `clean_contradiction_excess` 0.05)
+        let before = VerifyConfig {
+            clean_contradiction_excess: 0.05,
+            ..VerifyConfig::default()
+        };
+        assert!(rivals(&best, &twin(scores(0.90, 430, 0.027)), &before));
+        // ... and more than the best's own share plus 0.02, up to 0.05: a rival of a best at
+        // 0.01 may put up to 0.04 there, of one at 0.04 up to 0.09.
+        let at = |c: f64| scores(1.0, 622, c);
+        assert!(rivals(&at(0.01), &twin(scores(1.0, 622, 0.039)), &config));
+        assert!(!rivals(&at(0.01), &twin(scores(1.0, 622, 0.041)), &config));
+        assert!(rivals(&at(0.04), &twin(scores(1.0, 622, 0.089)), &config));
+        assert!(!rivals(&at(0.04), &twin(scores(1.0, 622, 0.091)), &config));
+        // ... or fails.
         let failed = Candidate {
             accepted: false,
             ..twin(best)

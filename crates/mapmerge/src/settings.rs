@@ -294,6 +294,10 @@ impl VerifyConfig {
                 ("max_ambiguity", self.max_ambiguity),
                 ("distinct_px", self.distinct_px),
                 ("max_contradiction_excess", self.max_contradiction_excess),
+                (
+                    "clean_contradiction_excess",
+                    self.clean_contradiction_excess,
+                ),
                 ("trusted_wide_wall_lift", self.trusted_wide_wall_lift),
                 ("max_wall_contradiction", self.max_wall_contradiction),
                 ("crisp_wall_lift", self.crisp_wall_lift),
@@ -519,6 +523,9 @@ mod tests {
             }),
             ("pair.verify.max_contradiction_excess", |c| {
                 c.pair.verify.max_contradiction_excess = f64::NAN
+            }),
+            ("pair.verify.clean_contradiction_excess", |c| {
+                c.pair.verify.clean_contradiction_excess = f64::NAN
             }),
             ("pair.verify.trusted_wide_wall_lift", |c| {
                 c.pair.verify.trusted_wide_wall_lift = f64::NAN

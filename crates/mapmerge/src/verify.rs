@@ -111,6 +111,15 @@ pub struct VerifyConfig {
     /// a twin of a room with a little inner structure (a half wall, a pillar) fits the outer
     /// walls as well as the truth, but puts the inner structure in free space.
     pub max_contradiction_excess: f64,
+    /// The excess of wall in free space allowed a rival (see `max_contradiction_excess`) when
+    /// the best puts none of its walls there; it grows one for one with the best's own
+    /// [`Verification::wall_contradiction`], up to `max_contradiction_excess`. Default 0.02:
+    /// against a best that fits cleanly, a rival that puts 2.5-4.6 % of its walls into free
+    /// space is not one answer among equals. Indoor pairs of clean maps with repeating rooms
+    /// were declined as ambiguous over such rivals, their best within 1.7 px of the truth
+    /// (docs/EVALUATION.md, "Clean answers and their rivals"). At
+    /// `max_contradiction_excess` (or more) the rule is the one before.
+    pub clean_contradiction_excess: f64,
     /// A best placement that fits at least this well (wide wall lift,
     /// [`Verification::wide_wall_lift`]) is rivalled only by placements that fit about as well
     /// (see `max_ambiguity`); one that fits worse is rivalled by every clearly different
@@ -319,6 +328,7 @@ impl Default for VerifyConfig {
             max_ambiguity: 0.6,
             distinct_px: 10.0,
             max_contradiction_excess: 0.05,
+            clean_contradiction_excess: 0.02,
             trusted_wide_wall_lift: 0.95,
             max_wall_contradiction: 0.21,
             clean_walls: Some(CleanWalls::default()),
