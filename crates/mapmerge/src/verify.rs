@@ -114,9 +114,9 @@ pub struct VerifyConfig {
     /// The excess of wall in free space allowed a rival (see `max_contradiction_excess`) when
     /// the best puts none of its walls there; it grows one for one with the best's own
     /// [`Verification::wall_contradiction`], up to `max_contradiction_excess`. Default 0.02:
-    /// against a best that fits cleanly, a rival that puts 2.5-4.6 % of its walls into free
+    /// against a best that fits cleanly, a rival that puts 2.5-5.4 % of its walls into free
     /// space is not one answer among equals. Indoor pairs of clean maps with repeating rooms
-    /// were declined as ambiguous over such rivals, their best within 1.7 px of the truth
+    /// were declined as ambiguous over such rivals, their best within 2.4 px of the truth
     /// (docs/EVALUATION.md, "Clean answers and their rivals"). At
     /// `max_contradiction_excess` (or more) the rule is the one before.
     pub clean_contradiction_excess: f64,

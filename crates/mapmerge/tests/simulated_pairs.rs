@@ -321,8 +321,8 @@ fn walls_kept_as_bands_are_not_pushed_apart() {
 /// Case 9003013 of `cargo xtask eval --suites overlap --only "indoor, overlap 0.3" --seed 9
 /// --mapper hector --noise 0.02`: clean maps (a lidar's 2 % range noise) of rooms that repeat.
 /// The best placement lies 1.1 px from the truth and puts none of its walls into the other
-/// map's free space; a placement 267 px away fits 0.91 of its walls at 0.77 of the best's
-/// score but puts 3.1 % of them there. With the rival's allowance of 0.05 whatever the best
+/// map's free space; a placement 267 px away fits at wall lift 0.91 and 0.77 of the best's
+/// score but puts 3.1 % of its walls there. With the rival's allowance of 0.05 whatever the best
 /// (`VerifyConfig::clean_contradiction_excess` at 0.05, the rule before) the pair was declined
 /// as ambiguous; against a best this clean 0.02 is allowed, and the best is the answer.
 #[test]
