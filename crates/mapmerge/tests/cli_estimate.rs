@@ -11,7 +11,7 @@ use grid_core::{CellState, DVec2, OccupancyGrid, Rigid2};
 use tempfile::TempDir;
 
 mod common;
-use common::{estimate_json, fixture, tiny_map};
+use common::{estimate_json, fixture, sparse_walls_map, tiny_map};
 
 fn run(args: &[&Path]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_mapmerge"))
@@ -188,15 +188,6 @@ fn an_answer_on_fewer_cells_than_min_overlap_cells_is_declined_as_too_small() {
             "{e}"
         );
     }
-}
-
-/// A 50 x 50 map, free but for `walls` occupied cells along its first row.
-fn sparse_walls_map(dir: &Path, name: &str, walls: usize) -> PathBuf {
-    let pgm = dir.join(name);
-    let mut bytes = b"P5\n50 50\n255\n".to_vec();
-    bytes.extend((0..2500).map(|i| if i < walls { 0u8 } else { 254 }));
-    std::fs::write(&pgm, bytes).unwrap();
-    pgm
 }
 
 #[test]

@@ -9,7 +9,7 @@ use std::path::PathBuf;
 use serde_json::{Value, json};
 
 mod common;
-use common::{mapmerge, tiny_map};
+use common::{mapmerge, sparse_walls_map, tiny_map};
 
 fn fixture(name: &str, ext: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -291,10 +291,7 @@ fn a_map_no_pair_can_be_accepted_with_is_noted() {
         "{text}"
     );
     // A map with known cells enough but no wall gets its own note.
-    let free = dir.path().join("free.pgm");
-    let mut bytes = b"P5\n50 50\n255\n".to_vec();
-    bytes.extend([254u8; 2500]);
-    std::fs::write(&free, bytes).unwrap();
+    let free = sparse_walls_map(dir.path(), "free.pgm", 0);
     let out = mapmerge(&["info", free.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(0));
     let text = String::from_utf8(out.stdout).unwrap();

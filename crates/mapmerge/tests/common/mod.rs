@@ -52,6 +52,16 @@ pub fn tiny_map(dir: &Path) -> PathBuf {
     pgm
 }
 
+/// A 50 x 50 bare map in `dir/name`: 2,500 known cells, free but for `walls` occupied cells
+/// along its first row.
+pub fn sparse_walls_map(dir: &Path, name: &str, walls: usize) -> PathBuf {
+    let pgm = dir.join(name);
+    let mut bytes = b"P5\n50 50\n255\n".to_vec();
+    bytes.extend((0..2500).map(|i| if i < walls { 0u8 } else { 254 }));
+    std::fs::write(&pgm, bytes).unwrap();
+    pgm
+}
+
 /// Run `mapmerge estimate A B --json` with `flags`.
 pub fn estimate_json(a: &Path, b: &Path, flags: &[&str]) -> Output {
     let (a, b) = (a.to_str().unwrap(), b.to_str().unwrap());
