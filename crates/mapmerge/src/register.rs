@@ -695,7 +695,7 @@ fn rivals(best: &Verification, c: &Candidate, config: &VerifyConfig) -> bool {
 /// and still rival it: [`VerifyConfig::clean_contradiction_excess`] plus the best's own
 /// share, at most [`VerifyConfig::max_contradiction_excess`].
 fn contradiction_excess(best: &Verification, config: &VerifyConfig) -> f64 {
-    (config.clean_contradiction_excess + best.wall_contradiction.max(0.0))
+    (config.clean_contradiction_excess + best.wall_contradiction)
         .min(config.max_contradiction_excess)
 }
 
