@@ -25,6 +25,7 @@ Sets (20 cases per row, as in docs/EVALUATION.md):
   floorzero  the same floors at zero overlap (must decline), seed 7
   crops   the same floors cut in two, sharing 30 % or nothing (must decline), seed 7
   sensor  three real robots' partial maps cut in two the same way, seeds 7, 8, 9
+  paper   the paper's setting at half, 30 % and zero overlap (must decline), seeds 7, 8, 9
 The batch without `sensor` (2,100 cases) took 18 minutes on a 2-core Intel Xeon VM
 (2026-12-06, 02:09-02:27 UTC); `sensor` (360 cases) takes about a minute more, and the
 counting mappers' sets `o30g`, `o30s` and `zeros` (2026-12-07; 520 cases) about three on
@@ -177,6 +178,13 @@ const SETS: &[Set] = &[
         mapper: None,
         seeds: &[7, 8, 9],
     },
+    Set {
+        name: "paper",
+        suites: "paper",
+        only: None,
+        mapper: None,
+        seeds: &[7, 8, 9],
+    },
 ];
 
 /// `eval`'s arguments as one wraps them to parse them alone.
@@ -319,7 +327,10 @@ mod tests {
                 "crops_7",
                 "sensor_7",
                 "sensor_8",
-                "sensor_9"
+                "sensor_9",
+                "paper_7",
+                "paper_8",
+                "paper_9"
             ]
         );
         for (_, argv) in &runs {
