@@ -789,6 +789,20 @@ fn crop_rows(rows: &mut Vec<Row>, suite: &'static str, names: &[&str]) -> Result
     Ok(())
 }
 
+/// A row of the `paper` suite: the paper's setting ([`CaseConfig::paper`]) at `overlap`, within
+/// `tolerance`; a pair that shares nothing must be declined.
+fn paper_row(label: &str, overlap: f64, tolerance: f64) -> Row {
+    let mut config = CaseConfig::paper();
+    config.overlap = overlap;
+    config.overlap_tolerance = tolerance;
+    Row {
+        suite: "paper",
+        label: label.into(),
+        source: Source::Robots(config),
+        expect_decline: overlap == 0.0,
+    }
+}
+
 fn floor_at_30(suite: &'static str, name: &str) -> Result<Row> {
     Ok(Row {
         suite,
@@ -870,14 +884,11 @@ fn rows(suites: &[String], size: usize, mapper: Mapper) -> Result<Vec<Row>> {
         }
     }
     if want("paper") {
-        let mut config = CaseConfig::paper();
-        config.overlap_tolerance = f64::INFINITY;
-        rows.push(Row {
-            suite: "paper",
-            label: "paper preset: 150x150, 16 IR beams, noise 10%/15%".into(),
-            source: Source::Robots(config),
-            expect_decline: false,
-        });
+        rows.push(paper_row(
+            "paper preset: 150x150, 16 IR beams, noise 10%/15%",
+            0.5,
+            f64::INFINITY,
+        ));
     }
     if want("real") {
         for name in ["wpi_ilab", "aws_small_house", "uos_cic", "intel_lab"] {
@@ -913,15 +924,7 @@ fn rows(suites: &[String], size: usize, mapper: Mapper) -> Result<Vec<Row>> {
     if want("paper") {
         // The paper's claim that 30 % overlap suffices, in its own setting. Listed last, like
         // the noisy zero-overlap rows, so that every other row keeps its cases.
-        let mut config = CaseConfig::paper();
-        config.overlap = 0.3;
-        config.overlap_tolerance = 0.05;
-        rows.push(Row {
-            suite: "paper",
-            label: "paper preset at overlap 0.3".into(),
-            source: Source::Robots(config),
-            expect_decline: false,
-        });
+        rows.push(paper_row("paper preset at overlap 0.3", 0.3, 0.05));
     }
     if want("real") {
         // A warehouse (the nav2 depot: shelf rows that repeat). Listed last, so that every
@@ -978,15 +981,11 @@ fn rows(suites: &[String], size: usize, mapper: Mapper) -> Result<Vec<Row>> {
         // The paper's setting where the two robots' areas do not overlap: small, sparse maps
         // (16 beams of 30 cells), which fit somewhere on each other more easily than a lidar's.
         // Listed last, so that every other row keeps its cases.
-        let mut config = CaseConfig::paper();
-        config.overlap = 0.0;
-        config.overlap_tolerance = 0.02;
-        rows.push(Row {
-            suite: "paper",
-            label: "paper preset at overlap 0 (must decline)".into(),
-            source: Source::Robots(config),
-            expect_decline: true,
-        });
+        rows.push(paper_row(
+            "paper preset at overlap 0 (must decline)",
+            0.0,
+            0.02,
+        ));
     }
     anyhow::ensure!(!rows.is_empty(), "no known suite in {suites:?}");
     if mapper != Mapper::Default {
