@@ -26,11 +26,9 @@ Sets (20 cases per row, as in docs/EVALUATION.md):
   crops   the same floors cut in two, sharing 30 % or nothing (must decline), seed 7
   sensor  three real robots' partial maps cut in two the same way, seeds 7, 8, 9
   paper   the paper's setting at half, 30 % and zero overlap (must decline), seeds 7, 8, 9
-The batch without `sensor` (2,100 cases) took 18 minutes on a 2-core Intel Xeon VM
-(2026-12-06, 02:09-02:27 UTC); `sensor` (360 cases) takes about a minute more, and the
-counting mappers' sets `o30g`, `o30s` and `zeros` (2026-12-07; 520 cases) about three on
-the 2-core AMD EPYC VM. `cargo xtask calibrate DIR` then tabulates its answers' errors by
-confidence.
+The whole batch (3,280 cases) took 20 min 31 s on the 2-core AMD EPYC VM (2026-12-07,
+11:46-12:11 UTC, with a one-minute eval beside it for part of that time). `cargo xtask
+calibrate DIR` then tabulates its answers' errors by confidence.
 
 Examples:
   cargo xtask regress --out /tmp/before
