@@ -44,7 +44,7 @@ mod testmaps;
 
 pub use error::Error;
 pub use register::{
-    Candidate, KindTotals, ManhattanRotation, Method, Origin, PairConfig, PolishConfig,
-    RegisterConfig, Registration, SpectrumRotation, Timings, TurnScan, framed, refine_and_score,
-    register, register_with,
+    APART_POINTS, Candidate, KindTotals, ManhattanRotation, Method, Origin, PairConfig,
+    PolishConfig, RegisterConfig, Registration, RunnerUp, SpectrumRotation, Timings, TurnScan,
+    framed, mean_apart, refine_and_score, register, register_with,
 };

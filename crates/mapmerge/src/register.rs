@@ -5,7 +5,9 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 use blob_features::{BlobConfig, BlobCorrespondences, Blobs};
-use grid_core::{Correspondence, CorrespondenceSource, DVec2, EvidenceKind, OccupancyGrid, Rigid2};
+use grid_core::{
+    CellState, Correspondence, CorrespondenceSource, DVec2, EvidenceKind, OccupancyGrid, Rigid2,
+};
 use ransac_rigid::{RansacConfig, estimate_rigid};
 use sift_desc::{SiftConfig, SiftCorrespondences};
 
@@ -650,6 +652,74 @@ pub struct Registration {
     pub matches: Vec<Correspondence>,
 }
 
+/// The runner-up of a registration ([`Registration::runner_up`]): the best-ranked candidate
+/// placed clearly apart from the answer.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunnerUp {
+    /// The candidate, as [`Registration::candidates`] holds it.
+    pub candidate: Candidate,
+    /// How far apart it and the answer put B's walls: the mean distance, in pixels, over up
+    /// to [`APART_POINTS`] of B's wall cells ([`mean_apart`]).
+    pub apart_px: f64,
+    /// Its [`Verification::score`] over the answer's (0 when the answer scores 0). Above 1
+    /// only when it fails a bar the answer passes.
+    pub score_ratio: f64,
+}
+
+/// Wall cells of B over which [`mean_apart`] measures two placements, at most.
+pub const APART_POINTS: usize = 500;
+
+/// How far apart placements `x` and `y` put `points` (B's wall cells): the mean distance, in
+/// pixels, between each point's two images; 0 for no point. The ambiguity test's and the
+/// runner-up's measure of "different" ([`VerifyConfig::distinct_px`]).
+pub fn mean_apart(points: &[DVec2], x: &Rigid2, y: &Rigid2) -> f64 {
+    points
+        .iter()
+        .map(|p| (x.apply(*p) - y.apply(*p)).length())
+        .sum::<f64>()
+        / points.len().max(1) as f64
+}
+
+impl Registration {
+    /// The best-ranked candidate after the first that places `b` (the map registered onto A,
+    /// in its own pixels, as the candidates' transforms are) at least `distinct_px` apart from
+    /// it ([`mean_apart`] over up to [`APART_POINTS`] of `b`'s wall cells, evenly strided):
+    /// the placement a user would weigh the answer against. The first candidate is the answer
+    /// when the pair was accepted and the best rejected one when it was declined. `None` when
+    /// no candidate is that far from the first, or `b` has no wall cell.
+    ///
+    /// A runner-up that passes the bars and scores near the answer is what makes a pair
+    /// ambiguous, and declined; one that passes but scores well below it (a room's turned twin
+    /// that fits as cleanly over fewer walls) is worth a look.
+    pub fn runner_up(&self, b: &OccupancyGrid, distinct_px: f64) -> Option<RunnerUp> {
+        let first = self.candidates.first()?;
+        let walls: Vec<DVec2> = (0..b.height())
+            .flat_map(|y| (0..b.width()).map(move |x| (x, y)))
+            .filter(|&(x, y)| b.state(x, y) == CellState::Occupied)
+            .map(|(x, y)| DVec2::new(x as f64, y as f64))
+            .collect();
+        if walls.is_empty() {
+            return None;
+        }
+        let probe = crate::verify::strided(&walls, APART_POINTS);
+        self.candidates.iter().skip(1).find_map(|c| {
+            let apart_px = mean_apart(&probe, &first.transform, &c.transform);
+            (apart_px >= distinct_px).then(|| {
+                let best = first.verification.score();
+                RunnerUp {
+                    candidate: c.clone(),
+                    apart_px,
+                    score_ratio: if best > 0.0 {
+                        c.verification.score() / best
+                    } else {
+                        0.0
+                    },
+                }
+            })
+        })
+    }
+}
+
 /// A count per evidence kind.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
 pub struct KindTotals {
@@ -1273,14 +1343,8 @@ fn register_as_given(
     rank(&mut candidates);
     // How far apart two placements put B's walls, on average (the ambiguity test's and the
     // stand-out rule's measure of "different").
-    let probe = crate::verify::strided(&pb.wall_samples, 500);
-    let apart = |x: &Rigid2, y: &Rigid2| {
-        probe
-            .iter()
-            .map(|p| (x.apply(*p) - y.apply(*p)).length())
-            .sum::<f64>()
-            / probe.len().max(1) as f64
-    };
+    let probe = crate::verify::strided(&pb.wall_samples, APART_POINTS);
+    let apart = |x: &Rigid2, y: &Rigid2| mean_apart(&probe, x, y);
     // Nothing passed the bars: a placement may still stand out from every other (speckled
     // walls of a very noisy sensor). It is then probed for twins like any accepted answer.
     let refined_standing_out = |candidates: &mut Vec<Candidate>, rule: &StandOut| loop {
@@ -2149,5 +2213,95 @@ mod tests {
         assert!(displacement_error(&b, &best.transform, &truth).unwrap() < 0.5);
         let apart = displacement_error(&b, &best.transform, &best_of_all.transform).unwrap();
         assert!(apart < 0.05, "{apart} px from refining all");
+    }
+
+    #[test]
+    fn the_runner_up_is_the_best_ranked_candidate_clearly_apart_from_the_first() {
+        let placed = |tx: f64, lift: f64, accepted: bool| Candidate {
+            transform: Rigid2::new(0.0, tx, 0.0),
+            ransac_inliers: 0,
+            ransac_confidence: 0.0,
+            verification: Verification {
+                wall_lift: lift,
+                wall_support: 400,
+                acceptance_index: 0.98,
+                ..Verification::default()
+            },
+            accepted,
+            stands_out: false,
+            origin: Origin::Sweep,
+            refined: true,
+        };
+        // Best first: the answer, a placement 3 px from it (one answer), then two apart.
+        let r = Registration {
+            accepted: Some(placed(0.0, 0.9, true)),
+            reason: None,
+            candidates: vec![
+                placed(0.0, 0.9, true),
+                placed(3.0, 0.85, true),
+                placed(40.0, 0.72, true),
+                placed(80.0, 0.3, false),
+            ],
+            correspondences: KindTotals::default(),
+            inliers: KindTotals::default(),
+            timings: Timings::default(),
+            matches: Vec::new(),
+        };
+        let b = room();
+        // Translations move every wall cell by the same distance: the mean is exact.
+        let u = r.runner_up(&b, 10.0).unwrap();
+        assert_eq!(u.candidate, r.candidates[2]);
+        assert!((u.apart_px - 40.0).abs() < 1e-9, "{}", u.apart_px);
+        assert!(
+            (u.score_ratio - 0.72 / 0.9).abs() < 1e-12,
+            "{}",
+            u.score_ratio
+        );
+        // The first one farther than the bar, whatever comes after.
+        let u = r.runner_up(&b, 41.0).unwrap();
+        assert_eq!(u.candidate, r.candidates[3]);
+        assert!((u.apart_px - 80.0).abs() < 1e-9);
+        assert!(r.runner_up(&b, 81.0).is_none());
+        // Turned half a turn about the room's centre, B's walls move by twice their distance
+        // from it: the mean over the (strided) wall cells.
+        let c = DVec2::new(60.0, 60.0);
+        let turned = Candidate {
+            transform: Rigid2::rotation_about(std::f64::consts::PI, c),
+            ..placed(0.0, 0.8, true)
+        };
+        let r = Registration {
+            candidates: vec![placed(0.0, 0.9, true), turned],
+            ..r
+        };
+        let walls: Vec<DVec2> = (0..b.height())
+            .flat_map(|y| (0..b.width()).map(move |x| (x, y)))
+            .filter(|&(x, y)| b.state(x, y) == CellState::Occupied)
+            .map(|(x, y)| DVec2::new(x as f64, y as f64))
+            .collect();
+        let probe = crate::verify::strided(&walls, APART_POINTS);
+        let expected =
+            probe.iter().map(|p| 2.0 * (*p - c).length()).sum::<f64>() / probe.len() as f64;
+        let u = r.runner_up(&b, 10.0).unwrap();
+        assert!(
+            (u.apart_px - expected).abs() < 1e-9,
+            "{} against {expected}",
+            u.apart_px
+        );
+        // No wall cell in B, or no other candidate: no runner-up.
+        let cells = vec![0; b.width() * b.height()];
+        let blank = OccupancyGrid::from_cells(
+            b.width(),
+            b.height(),
+            0.05,
+            grid_core::Pose2::default(),
+            cells,
+        )
+        .unwrap();
+        assert!(r.runner_up(&blank, 10.0).is_none());
+        let alone = Registration {
+            candidates: vec![placed(0.0, 0.9, true)],
+            ..r
+        };
+        assert!(alone.runner_up(&b, 10.0).is_none());
     }
 }

@@ -100,6 +100,66 @@ fn registers_the_real_overlapping_pair() {
 }
 
 #[test]
+fn the_runner_up_is_reported_with_how_far_it_lies_from_the_answer() {
+    let b_path = fixture("sunil_pair_b");
+    let out = run(&[&fixture("sunil_pair_a"), &b_path]);
+    assert_eq!(out.status.code(), Some(0));
+    let v = json(&out);
+    let u = &v["runner_up"];
+    assert!(u.is_object(), "{v}");
+    // Its distance from the answer, over all of B's wall cells (the binary strides them to
+    // 500): at least the 10 px that make two placements different, and as reported.
+    let b = load_map(&b_path, &LoadOptions::default()).unwrap();
+    let (answer, other) = (transform(&v), common::transform(&u["transform"]));
+    let walls: Vec<DVec2> = (0..b.height())
+        .flat_map(|y| (0..b.width()).map(move |x| (x, y)))
+        .filter(|&(x, y)| b.state(x, y) == CellState::Occupied)
+        .map(|(x, y)| DVec2::new(x as f64, y as f64))
+        .collect();
+    let apart = walls
+        .iter()
+        .map(|p| (answer.apply(*p) - other.apply(*p)).length())
+        .sum::<f64>()
+        / walls.len() as f64;
+    let reported = u["apart_px"].as_f64().unwrap();
+    assert!(reported >= 10.0, "{u}");
+    assert!(
+        (reported - apart).abs() < 0.05 * apart,
+        "{reported} against {apart}"
+    );
+    // The score ratio is that of the two verifications' scores (lift x support x index).
+    let score = |v: &serde_json::Value| {
+        v["wall_lift"].as_f64().unwrap()
+            * v["wall_support"].as_f64().unwrap()
+            * v["acceptance_index"].as_f64().unwrap()
+    };
+    let ratio = score(&u["verification"]) / score(&v["verification"]);
+    assert!(
+        (u["score_ratio"].as_f64().unwrap() - ratio).abs() < 1e-9,
+        "{u}"
+    );
+    // This pair's runner-up fits poorly: below the bars, well under the answer.
+    assert_eq!(u["passes"], false, "{u}");
+    assert!(ratio < 0.6, "{u}");
+    // The text form says the same in one line.
+    let text = Command::new(env!("CARGO_BIN_EXE_mapmerge"))
+        .arg("estimate")
+        .args([&fixture("sunil_pair_a"), &b_path])
+        .output()
+        .unwrap();
+    let text = String::from_utf8(text.stdout).unwrap();
+    let line = text
+        .lines()
+        .find(|l| l.starts_with("runner-up: "))
+        .unwrap_or_else(|| panic!("{text}"));
+    assert!(
+        line.contains(&format!("{reported:.0} px from the answer"))
+            && line.ends_with("below the bars"),
+        "{line}"
+    );
+}
+
+#[test]
 fn unrelated_maps_are_declined_with_exit_3() {
     for (a, b) in [("wpi_ilab", "tb3_world"), ("aws_small_house", "wpi_ilab")] {
         let out = run(&[&fixture(a), &fixture(b)]);

@@ -35,6 +35,12 @@ Output (--json): one JSON object on stdout.
   verification     wall_agreement, wall_lift, wide_wall_lift, wall_contradiction (share of walls
                    landing in the other map's free space), acceptance_index, overlap_cells,
                    overlap_fraction, wall_density
+  runner_up        the best-ranked other placement at least 10 px from the answer (mean over
+                   B's walls), or null: transform, apart_px, score_ratio (its verification
+                   score over the answer's), passes (whether it passes the bars), verification,
+                   hypothesis. One that passes and scores 0.6 of the answer or more makes the
+                   pair ambiguous, and declined; one that passes below that (a turned twin of
+                   a symmetric room that fits as cleanly over fewer walls) is worth a look
   method, hypothesis (ransac, global, sweep or symmetry), correspondences, candidates, timings_ms
 
 Exit codes: 0 transform found, 3 no trustworthy match (the pair is declined), 2 bad usage or
@@ -102,7 +108,13 @@ pub fn run(args: &EstimateArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode
             config.pair.ransac.threshold_px,
         )?;
     }
-    let out = report(args, &a.grid, &b.grid, &result);
+    let out = report(
+        args,
+        &a.grid,
+        &b.grid,
+        &result,
+        config.pair.verify.distinct_px,
+    );
     let mut stdout = std::io::stdout().lock();
     if args.json {
         writeln!(stdout, "{out}").context("cannot write to stdout")?;
@@ -121,7 +133,19 @@ fn report(
     a: &OccupancyGrid,
     b: &OccupancyGrid,
     r: &Registration,
+    distinct_px: f64,
 ) -> serde_json::Value {
+    let runner_up = r.runner_up(b, distinct_px).map(|u| {
+        let (c, t) = (&u.candidate, &u.candidate.transform);
+        json!({
+            "transform": {"theta": t.theta, "tx": t.tx, "ty": t.ty},
+            "apart_px": u.apart_px,
+            "score_ratio": u.score_ratio,
+            "passes": c.accepted,
+            "verification": c.verification,
+            "hypothesis": c.origin,
+        })
+    });
     let common = json!({
         "a": args.a.display().to_string(),
         "b": args.b.display().to_string(),
@@ -129,6 +153,7 @@ fn report(
         "seed": args.registration.seed,
         "correspondences": r.correspondences,
         "candidates": r.candidates.len(),
+        "runner_up": runner_up,
         "timings_ms": r.timings,
     });
     let mut out = match &r.accepted {
@@ -200,6 +225,26 @@ fn human(w: &mut impl Write, o: &serde_json::Value) -> std::io::Result<()> {
                 w,
                 "accepted because it stands out: no placement reached the wall lift bars, and this one (lift {:.2} at 4 px) fits clearly better than every other",
                 v["wide_wall_lift"].as_f64().unwrap_or(0.0)
+            )?;
+        }
+        let u = &o["runner_up"];
+        if !u.is_null() {
+            let (t, uv) = (&u["transform"], &u["verification"]);
+            writeln!(
+                w,
+                "runner-up: theta {:.3} deg, tx {:.2} px, ty {:.2} px, {:.0} px from the answer (mean over B's walls); wall lift {:.2} (at 4 px {:.2}), score {:.2} of the answer's, {}",
+                t["theta"].as_f64().unwrap_or(0.0).to_degrees(),
+                t["tx"].as_f64().unwrap_or(0.0),
+                t["ty"].as_f64().unwrap_or(0.0),
+                u["apart_px"].as_f64().unwrap_or(0.0),
+                uv["wall_lift"].as_f64().unwrap_or(0.0),
+                uv["wide_wall_lift"].as_f64().unwrap_or(0.0),
+                u["score_ratio"].as_f64().unwrap_or(0.0),
+                if u["passes"].as_bool() == Some(true) {
+                    "passing the bars"
+                } else {
+                    "below the bars"
+                }
             )?;
         }
     }
