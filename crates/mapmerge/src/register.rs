@@ -688,9 +688,9 @@ impl Registration {
     /// when the pair was accepted and the best rejected one when it was declined. `None` when
     /// no candidate is that far from the first, or `b` has no wall cell.
     ///
-    /// A runner-up that passes the bars and scores near the answer is what makes a pair
-    /// ambiguous, and declined; one that passes but scores well below it (a room's turned twin
-    /// that fits as cleanly over fewer walls) is worth a look.
+    /// A runner-up that passes the bars and fits about as well as the answer is what mostly
+    /// makes a pair ambiguous, and declined (the ambiguity test also weighs the walls each puts
+    /// in free space and whether the two are one broad optimum).
     pub fn runner_up(&self, b: &OccupancyGrid, distinct_px: f64) -> Option<RunnerUp> {
         let first = self.candidates.first()?;
         let walls: Vec<DVec2> = (0..b.height())

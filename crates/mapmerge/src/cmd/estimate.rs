@@ -38,9 +38,9 @@ Output (--json): one JSON object on stdout.
   runner_up        the best-ranked other placement at least 10 px from the answer (mean over
                    B's walls), or null: transform, apart_px, score_ratio (its verification
                    score over the answer's), passes (whether it passes the bars), verification,
-                   hypothesis. One that passes and scores 0.6 of the answer or more makes the
-                   pair ambiguous, and declined; one that passes below that (a turned twin of
-                   a symmetric room that fits as cleanly over fewer walls) is worth a look
+                   hypothesis: where else the maps fit, and how well. One that passes and
+                   fits about as well as the answer (0.6 of its score or more) mostly makes
+                   the pair ambiguous, and declined
   method, hypothesis (ransac, global, sweep or symmetry), correspondences, candidates, timings_ms
 
 Exit codes: 0 transform found, 3 no trustworthy match (the pair is declined), 2 bad usage or
