@@ -114,13 +114,15 @@ proptest! {
     /// away and refine to a poorer fit (wall lift 0.64), and the local search, even over
     /// +-24 px instead of 8 (scratch code), stays at the probe's placement, whose walls it
     /// scores higher than the truth's: that placement overlaps more.
-    /// How often, measured 2026-12-07 (a33b381; scratch code drawing 100 cases of this
-    /// strategy at proptest seeds 1, 3 and 7 and registering each): 259 of 300 accepted, 5 of
-    /// them wrong (73-127 px off at wall lift 0.90-0.96), 41 declined. All five are the truth
+    /// How often, measured 2026-12-07 (registration code of a33b381; `cargo run --release -p
+    /// mapmerge --example property_pairs -- S 100`, which draws this strategy's pairs at
+    /// proptest seed S, for S = 1, 3 and 7): 259 of 300 accepted, 5 of them wrong (73-127 px
+    /// off at wall lift 0.90-0.96), 41 declined. All five are the truth
     /// turned by a half turn (four) or a quarter turn (one), laying B over 81-99 % of the
     /// smaller map where the truth overlaps 60-76 %: the truth, refined, fits at wall lift
     /// 0.85-0.96 but compares a third to three fifths as many walls, so it scores 0.3-0.6 of
-    /// the answer. In four of them no candidate came within 14 px of the truth; in the fifth
+    /// the answer (scratch code from here on). In four of them no candidate came within 14 px
+    /// of the truth; in the fifth
     /// a probe's twin 1.0 px from it fitted at wide lift 1.00 against the answer's 0.96, yet
     /// scored 0.58 of it, under the ambiguity test's bar (`VerifyConfig::max_ambiguity`, 0.6).
     /// With `MAPMERGE_PROPTEST_SEED=S PROPTEST_CASES=100` the test fails at seeds 1, 3, 4, 6,
