@@ -661,8 +661,9 @@ pub struct RunnerUp {
     /// How far apart it and the answer put B's walls: the mean distance, in pixels, over up
     /// to [`APART_POINTS`] of B's wall cells ([`mean_apart`]).
     pub apart_px: f64,
-    /// Its [`Verification::score`] over the answer's (0 when the answer scores 0). Above 1
-    /// only when it fails a bar the answer passes.
+    /// Its [`Verification::score`] over the answer's (0 when the answer scores 0). It can
+    /// exceed 1: the ranking puts the placements that pass the bars first, and the answer's
+    /// pose is refined after the ranking.
     pub score_ratio: f64,
 }
 
@@ -682,8 +683,9 @@ pub fn mean_apart(points: &[DVec2], x: &Rigid2, y: &Rigid2) -> f64 {
 
 impl Registration {
     /// The best-ranked candidate after the first that places `b` (the map registered onto A,
-    /// in its own pixels, as the candidates' transforms are) at least `distinct_px` apart from
-    /// it ([`mean_apart`] over up to [`APART_POINTS`] of `b`'s wall cells, evenly strided):
+    /// in its own pixels, as the candidates' transforms are) more than `distinct_px` apart from
+    /// it ([`mean_apart`] over up to [`APART_POINTS`] of `b`'s wall cells, evenly strided, as
+    /// the ambiguity test measures two placements):
     /// the placement a user would weigh the answer against. The first candidate is the answer
     /// when the pair was accepted and the best rejected one when it was declined. `None` when
     /// no candidate is that far from the first, or `b` has no wall cell.
@@ -704,7 +706,7 @@ impl Registration {
         let probe = crate::verify::strided(&walls, APART_POINTS);
         self.candidates.iter().skip(1).find_map(|c| {
             let apart_px = mean_apart(&probe, &first.transform, &c.transform);
-            (apart_px >= distinct_px).then(|| {
+            (apart_px > distinct_px).then(|| {
                 let best = first.verification.score();
                 RunnerUp {
                     candidate: c.clone(),

@@ -35,7 +35,7 @@ Output (--json): one JSON object on stdout.
   verification     wall_agreement, wall_lift, wide_wall_lift, wall_contradiction (share of walls
                    landing in the other map's free space), acceptance_index, overlap_cells,
                    overlap_fraction, wall_density
-  runner_up        the best-ranked other placement at least 10 px from the answer (mean over
+  runner_up        the best-ranked other placement more than 10 px from the answer (mean over
                    B's walls), or null: transform, apart_px, score_ratio (its verification
                    score over the answer's), passes (whether it passes the bars), verification,
                    hypothesis: where else the maps fit, and how well. One that passes and
