@@ -66,7 +66,8 @@ pub struct EstimateArgs {
     #[command(flatten)]
     pub registration: RegistrationArgs,
     /// Write a picture of A, B with the matches (green: inliers, red: outliers) and B laid
-    /// over A with the answer, both whole (A's walls blue, B's red, agreeing walls black)
+    /// over A with the answer, both whole (A's walls blue, B's red, agreeing walls black); and
+    /// B laid over A with the runner-up, when it passes the bars too
     #[arg(long, value_name = "FILE")]
     pub debug_png: Option<PathBuf>,
 }
@@ -106,6 +107,7 @@ pub fn run(args: &EstimateArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode
             &b.grid,
             &result,
             config.pair.ransac.threshold_px,
+            config.pair.verify.distinct_px,
         )?;
     }
     let out = report(
@@ -327,14 +329,68 @@ fn overlay_bounds(a: &OccupancyGrid, b: &OccupancyGrid, t: &Rigid2) -> (i64, i64
     )
 }
 
+/// An overlay panel: B laid over A by a transform, over `(x0, y0, width, height)` of A's frame
+/// (its top left pixel A's pixel `(x0, y0)`).
+type Overlay = (Rigid2, i64, i64, usize, usize);
+
+/// The panel of B laid over A by `t`: the bounding box of both maps' known cells, B's placed by
+/// `t`. A placement far from A (a declined pair's best candidate can be anywhere) would make a
+/// picture of mostly nothing: A's canvas then.
+fn overlay(a: &OccupancyGrid, b: &OccupancyGrid, t: Rigid2) -> Overlay {
+    let (wa, ha, wb, hb) = (a.width(), a.height(), b.width(), b.height());
+    let (mut x0, mut y0, mut x1, mut y1) = overlay_bounds(a, b, &t);
+    let area = (x1 - x0 + 1) as f64 * (y1 - y0 + 1) as f64;
+    if area > 4.0 * ((wa * ha).max(wb * hb)) as f64 {
+        (x0, y0, x1, y1) = (0, 0, wa as i64 - 1, ha as i64 - 1);
+    }
+    (t, x0, y0, (x1 - x0 + 1) as usize, (y1 - y0 + 1) as usize)
+}
+
+/// Draw `overlay` with its left edge at column `ox` of `img`: A's walls blue, B's red, black
+/// where both have one, white where either saw free space, grey elsewhere.
+fn draw_overlay(
+    img: &mut image::RgbImage,
+    a: &OccupancyGrid,
+    b: &OccupancyGrid,
+    overlay: &Overlay,
+    ox: usize,
+) {
+    let &(t, x0, y0, wo, ho) = overlay;
+    let inv = t.inverse();
+    let state = |grid: &OccupancyGrid, q: DVec2| {
+        let q = q.round();
+        if q.x >= 0.0 && q.y >= 0.0 && q.x < grid.width() as f64 && q.y < grid.height() as f64 {
+            grid.state(q.x as usize, q.y as usize)
+        } else {
+            CellState::Unknown
+        }
+    };
+    for v in 0..ho {
+        for u in 0..wo {
+            let p = DVec2::new((x0 + u as i64) as f64, (y0 + v as i64) as f64);
+            let (sa, sb) = (state(a, p), state(b, inv.apply(p)));
+            let colour = match (sa, sb) {
+                (CellState::Occupied, CellState::Occupied) => [0, 0, 0],
+                (CellState::Occupied, _) => [40, 80, 230],
+                (_, CellState::Occupied) => [230, 40, 40],
+                (CellState::Free, _) | (_, CellState::Free) => [255, 255, 255],
+                _ => [205, 205, 205],
+            };
+            img.put_pixel((ox + u) as u32, v as u32, image::Rgb(colour));
+        }
+    }
+}
+
 /// Three panels: A, B (with match lines between them), and B laid over A with the answer, both
-/// whole.
+/// whole; a fourth, B laid over A with the runner-up (`runner_up`), when there is one that
+/// passes the bars too.
 fn write_debug_png(
     path: &Path,
     a: &OccupancyGrid,
     b: &OccupancyGrid,
     r: &Registration,
     threshold: f64,
+    distinct_px: f64,
 ) -> anyhow::Result<()> {
     const GAP: usize = 10;
     let (wa, ha, wb, hb) = (a.width(), a.height(), b.width(), b.height());
@@ -343,21 +399,15 @@ fn write_debug_png(
         .as_ref()
         .map(|c| c.transform)
         .or_else(|| r.candidates.first().map(|c| c.transform));
-    // The overlay covers the known cells of both maps, B's placed by the answer, in A's frame:
-    // its top left pixel is A's pixel `(x0, y0)`.
-    let overlay = t.map(|t| {
-        let (mut x0, mut y0, mut x1, mut y1) = overlay_bounds(a, b, &t);
-        // A placement far from A (a declined pair's best candidate can be anywhere) would make
-        // a picture of mostly nothing: A's canvas then.
-        let area = (x1 - x0 + 1) as f64 * (y1 - y0 + 1) as f64;
-        if area > 4.0 * ((wa * ha).max(wb * hb)) as f64 {
-            (x0, y0, x1, y1) = (0, 0, wa as i64 - 1, ha as i64 - 1);
-        }
-        (t, x0, y0, (x1 - x0 + 1) as usize, (y1 - y0 + 1) as usize)
-    });
-    let (wo, ho) = overlay.map_or((0, 0), |(_, _, _, w, h)| (w, h));
-    let width = wa + wb + wo + 2 * GAP;
-    let height = ha.max(hb).max(ho);
+    let answer = t.map(|t| overlay(a, b, t));
+    let runner_up = r
+        .runner_up(b, distinct_px)
+        .filter(|u| u.candidate.accepted)
+        .map(|u| overlay(a, b, u.candidate.transform));
+    let size = |o: &Option<Overlay>| o.map_or((0, 0), |(_, _, _, w, h)| (w, h));
+    let ((wo, ho), (wu, hu)) = (size(&answer), size(&runner_up));
+    let width = wa + wb + wo + 2 * GAP + if wu > 0 { wu + GAP } else { 0 };
+    let height = ha.max(hb).max(ho).max(hu);
     anyhow::ensure!(
         (width as u64) * (height as u64) <= 200_000_000,
         "{}: the debug picture would be {width} x {height} pixels; too large",
@@ -381,36 +431,94 @@ fn write_debug_png(
         let colour = if inlier { [0, 170, 0] } else { [220, 40, 40] };
         line(&mut img, c.a, c.b + DVec2::new(bx as f64, 0.0), colour);
     }
-    // Overlay right of B's panel.
+    // The overlays right of B's panel.
     let ox = bx + wb + GAP;
-    if let Some((t, x0, y0, wo, ho)) = overlay {
-        let inv = t.inverse();
-        let state = |grid: &OccupancyGrid, q: DVec2| {
-            let q = q.round();
-            if q.x >= 0.0 && q.y >= 0.0 && q.x < grid.width() as f64 && q.y < grid.height() as f64 {
-                grid.state(q.x as usize, q.y as usize)
-            } else {
-                CellState::Unknown
-            }
-        };
-        for v in 0..ho {
-            for u in 0..wo {
-                let p = DVec2::new((x0 + u as i64) as f64, (y0 + v as i64) as f64);
-                let (sa, sb) = (state(a, p), state(b, inv.apply(p)));
-                let colour = match (sa, sb) {
-                    (CellState::Occupied, CellState::Occupied) => [0, 0, 0],
-                    (CellState::Occupied, _) => [40, 80, 230],
-                    (_, CellState::Occupied) => [230, 40, 40],
-                    (CellState::Free, _) | (_, CellState::Free) => [255, 255, 255],
-                    _ => [205, 205, 205],
-                };
-                img.put_pixel((ox + u) as u32, v as u32, image::Rgb(colour));
-            }
-        }
+    if let Some(o) = &answer {
+        draw_overlay(&mut img, a, b, o, ox);
+    }
+    if let Some(o) = &runner_up {
+        draw_overlay(&mut img, a, b, o, ox + wo + GAP);
     }
     let mut png = Vec::new();
     img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
         .map_err(|e| anyhow::anyhow!("{}: cannot encode the debug picture: {e}", path.display()))?;
     grid_core::io::write_atomic(path, &png)
         .map_err(|e| anyhow::anyhow!("cannot write the debug picture: {e}"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use grid_core::Pose2;
+    use mapmerge::verify::Verification;
+    use mapmerge::{Candidate, KindTotals, Origin, Timings};
+
+    /// A room of `w x h` cells: walls on its border, free inside.
+    fn room(w: usize, h: usize) -> OccupancyGrid {
+        let cells = (0..w * h)
+            .map(|i| {
+                let (x, y) = (i % w, i / w);
+                if x == 0 || y == 0 || x == w - 1 || y == h - 1 {
+                    100
+                } else {
+                    0
+                }
+            })
+            .collect();
+        OccupancyGrid::from_cells(w, h, 0.05, Pose2::default(), cells).unwrap()
+    }
+
+    fn placed(tx: f64, accepted: bool) -> Candidate {
+        Candidate {
+            transform: Rigid2::new(0.0, tx, 0.0),
+            ransac_inliers: 0,
+            ransac_confidence: 0.0,
+            verification: Verification {
+                wall_lift: 0.9,
+                wall_support: 100,
+                acceptance_index: 0.98,
+                ..Verification::default()
+            },
+            accepted,
+            stands_out: false,
+            origin: Origin::Sweep,
+            refined: true,
+        }
+    }
+
+    #[test]
+    fn the_debug_picture_shows_a_runner_up_that_passes_in_a_fourth_panel() {
+        let (a, b) = (room(60, 40), room(30, 20));
+        let registration = |up: Candidate| Registration {
+            accepted: Some(placed(5.0, true)),
+            reason: None,
+            candidates: vec![placed(5.0, true), up],
+            correspondences: KindTotals::default(),
+            inliers: KindTotals::default(),
+            timings: Timings::default(),
+            matches: Vec::new(),
+        };
+        let dir = tempfile::TempDir::new().unwrap();
+        let path = dir.path().join("d.png");
+        // Each overlay spans A's known cells (B lies inside them): 60 px, 10 px apart.
+        let panels = |r: &Registration| {
+            write_debug_png(&path, &a, &b, r, 3.0, 10.0).unwrap();
+            image::open(&path).unwrap().to_rgb8()
+        };
+        let img = panels(&registration(placed(25.0, true)));
+        assert_eq!(img.width(), 60 + 30 + 60 + 60 + 3 * 10);
+        // The fourth panel lays B 20 px right of where the third does: B's left wall (x = 0 in
+        // B) lands on A's column 25 there, black where it meets A's walls and red between.
+        let fourth = 60 + 10 + 30 + 10 + 60 + 10;
+        let column = |x: u32| -> Vec<[u8; 3]> { (0..20).map(|y| img.get_pixel(x, y).0).collect() };
+        let red = [230, 40, 40];
+        assert_eq!(column(fourth + 25)[1..19], vec![red; 18][..]);
+        assert_eq!(column(fourth + 25)[0], [0, 0, 0]);
+        assert_eq!(column(60 + 10 + 30 + 10 + 5)[1..19], vec![red; 18][..]);
+        // Nothing between the third panel and the fourth but the gap.
+        assert_eq!(column(fourth - 5), vec![[90, 90, 90]; 20]);
+        // A runner-up below the bars gets no panel.
+        let img = panels(&registration(placed(25.0, false)));
+        assert_eq!(img.width(), 60 + 30 + 60 + 2 * 10);
+    }
 }
