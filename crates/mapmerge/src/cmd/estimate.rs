@@ -7,7 +7,7 @@ use std::process::ExitCode;
 use anyhow::Context;
 use clap::Args;
 use grid_core::{CellState, DVec2, OccupancyGrid, Rigid2};
-use mapmerge::{Registration, register};
+use mapmerge::{Registration, RunnerUp, register};
 use serde_json::json;
 
 use super::{
@@ -100,23 +100,19 @@ pub fn run(args: &EstimateArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode
     }
     let config = args.registration.config();
     let result = register(&a.grid, &b.grid, &config).context("invalid registration settings")?;
+    // Found once, for the report and the picture.
+    let runner_up = result.runner_up(&b.grid, config.pair.verify.distinct_px);
     if let Some(png) = &args.debug_png {
         write_debug_png(
             png,
             &a.grid,
             &b.grid,
             &result,
+            runner_up.as_ref(),
             config.pair.ransac.threshold_px,
-            config.pair.verify.distinct_px,
         )?;
     }
-    let out = report(
-        args,
-        &a.grid,
-        &b.grid,
-        &result,
-        config.pair.verify.distinct_px,
-    );
+    let out = report(args, &a.grid, &b.grid, &result, runner_up.as_ref());
     let mut stdout = std::io::stdout().lock();
     if args.json {
         writeln!(stdout, "{out}").context("cannot write to stdout")?;
@@ -135,9 +131,9 @@ fn report(
     a: &OccupancyGrid,
     b: &OccupancyGrid,
     r: &Registration,
-    distinct_px: f64,
+    runner_up: Option<&RunnerUp>,
 ) -> serde_json::Value {
-    let runner_up = r.runner_up(b, distinct_px).map(|u| {
+    let runner_up = runner_up.map(|u| {
         let (c, t) = (&u.candidate, &u.candidate.transform);
         json!({
             "transform": {"theta": t.theta, "tx": t.tx, "ty": t.ty},
@@ -382,15 +378,15 @@ fn draw_overlay(
 }
 
 /// Three panels: A, B (with match lines between them), and B laid over A with the answer, both
-/// whole; a fourth, B laid over A with the runner-up (`runner_up`), when there is one that
-/// passes the bars too.
+/// whole; a fourth, B laid over A with the runner-up ([`Registration::runner_up`]), when there
+/// is one that passes the bars too.
 fn write_debug_png(
     path: &Path,
     a: &OccupancyGrid,
     b: &OccupancyGrid,
     r: &Registration,
+    runner_up: Option<&RunnerUp>,
     threshold: f64,
-    distinct_px: f64,
 ) -> anyhow::Result<()> {
     const GAP: usize = 10;
     let (wa, ha, wb, hb) = (a.width(), a.height(), b.width(), b.height());
@@ -400,8 +396,7 @@ fn write_debug_png(
         .map(|c| c.transform)
         .or_else(|| r.candidates.first().map(|c| c.transform));
     let answer = t.map(|t| overlay(a, b, t));
-    let runner_up = r
-        .runner_up(b, distinct_px)
+    let runner_up = runner_up
         .filter(|u| u.candidate.accepted)
         .map(|u| overlay(a, b, u.candidate.transform));
     let size = |o: &Option<Overlay>| o.map_or((0, 0), |(_, _, _, w, h)| (w, h));
@@ -502,7 +497,7 @@ mod tests {
         let path = dir.path().join("d.png");
         // Each overlay spans A's known cells (B lies inside them): 60 px, 10 px apart.
         let panels = |r: &Registration| {
-            write_debug_png(&path, &a, &b, r, 3.0, 10.0).unwrap();
+            write_debug_png(&path, &a, &b, r, r.runner_up(&b, 10.0).as_ref(), 3.0).unwrap();
             image::open(&path).unwrap().to_rgb8()
         };
         let img = panels(&registration(placed(25.0, true)));
