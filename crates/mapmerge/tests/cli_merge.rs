@@ -486,8 +486,12 @@ fn a_map_that_shares_nothing_with_the_first_is_placed_through_another() {
     assert_eq!(statuses(&report), ["weak", "declined", "weak"], "{report}");
     assert!(!out.exists() && !out.with_extension("json").exists());
     // The middle crop's reason names its weak pair with the first and the bar that uses it;
-    // the east crop's weak pair is with the middle one, which is not placed: no such hint.
+    // the east crop's weak pair is with the middle one, so its reason names the chain through
+    // the middle crop and the bar that places it: the chain's lower lift. The report's reason
+    // gives the bar that places both.
     let lift = report["pairs"][0]["confidence"].as_f64().unwrap();
+    let chain = lift.min(report["pairs"][2]["confidence"].as_f64().unwrap());
+    let bar = |l: f64| (l * 100.0).floor() / 100.0;
     let unlinked = format!(
         "no pair accepted at wall lift 1 or more links it to {}",
         a.display()
@@ -498,10 +502,50 @@ fn a_map_that_shares_nothing_with_the_first_is_placed_through_another() {
             "{unlinked}; its pair with {} was accepted at wall lift {lift:.3}, below --min-lift \
              1: --min-lift {} uses it",
             a.display(),
-            (lift * 100.0).floor() / 100.0
+            bar(lift)
         )
     );
-    assert_eq!(report["maps"][2]["reason"], unlinked);
+    assert_eq!(
+        report["maps"][2]["reason"],
+        format!(
+            "{unlinked}; pairs accepted at wall lift {chain:.3} or more link it to {} through \
+             {}: --min-lift {} places it",
+            a.display(),
+            b.display(),
+            bar(chain)
+        )
+    );
+    assert_eq!(
+        report["reason"],
+        format!(
+            "no map could be placed in {}'s frame: no pair with it was accepted at wall lift 1 \
+             or more; --min-lift {} places the 2 maps that accepted pairs link to it",
+            a.display(),
+            bar(chain)
+        )
+    );
+    // That bar does place both.
+    let out = dir.path().join("chain.yaml");
+    let min_lift = bar(chain).to_string();
+    let o = merge(&[
+        s(&a),
+        s(&b),
+        s(&c),
+        "-o",
+        s(&out),
+        "--json",
+        "--min-lift",
+        &min_lift,
+    ]);
+    assert_eq!(o.status.code(), Some(0));
+    let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let merged: Vec<bool> = report["maps"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| m["merged"].as_bool().unwrap())
+        .collect();
+    assert_eq!(merged, [true, true, true], "{report}");
 }
 
 #[test]

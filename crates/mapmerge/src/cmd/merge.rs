@@ -55,8 +55,10 @@ occupancy of the cells it covers, a finer one repeats its cell.
 
 A map that no such pair links to the reference map is left out (a warning on stderr says
 so, naming its pair accepted below --min-lift with a placed map and the --min-lift that uses
-it, or the maps it does link to and the --reference that merges those) and the others are
-merged. When no map links to the reference, nothing is written.
+it, or the chain of such pairs through other maps and the --min-lift that places it, or the
+maps it does link to and the --reference that merges those) and the others are merged. When
+no map links to the reference, nothing is written, and the reason gives the --min-lift that
+would place every map the accepted pairs link to it.
 
 Exit codes: 0 merged map written, 3 no map could be placed in the reference map's frame
 (nothing written), 2 bad usage or bad input, 1 internal error.
@@ -89,7 +91,8 @@ pub struct MergeArgs {
     #[arg(long, default_value = "mean", value_parser = parse_rule)]
     pub rule: FusionRule,
     /// A pair places maps only when accepted at this wall lift or more: a map placed wrong
-    /// spoils the merged map, one left out is reported; 0 uses every pair `estimate` accepts
+    /// spoils the merged map, one left out is reported, with the bar that would place it
+    /// when pairs accepted below this one link it; 0 uses every pair `estimate` accepts
     #[arg(long, value_name = "LIFT", default_value_t = 0.75, value_parser = super::probability)]
     pub min_lift: f64,
     /// The map whose frame the merged map is in (and whose resolution it has, unless
@@ -274,32 +277,41 @@ pub fn run(args: &MergeArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode> {
             )
         })
     };
-    // A pair accepted below --min-lift that would link a map to the reference's maps.
+    // The lowest bar that would link a map to the reference's maps, through pairs accepted
+    // below --min-lift.
+    let lifts: Vec<(usize, usize, f64)> = merged
+        .pairs
+        .iter()
+        .filter_map(|p| {
+            let lift = p.registration.accepted.as_ref()?.verification.wall_lift;
+            Some((p.a, p.b, lift))
+        })
+        .collect();
+    let chains = widest_chains(args.maps.len(), &lifts, &groups[reference]);
     let weak_way_in = |k: usize| -> Option<String> {
-        let placed = &groups[reference];
-        merged
-            .pairs
-            .iter()
-            .filter(|p| p.edge.is_none())
-            .filter_map(|p| {
-                let other = match (p.a == k, p.b == k) {
-                    (true, _) => p.b,
-                    (_, true) => p.a,
-                    _ => return None,
-                };
-                let lift = p.registration.accepted.as_ref()?.verification.wall_lift;
-                placed.contains(&other).then_some((other, lift))
-            })
-            .max_by(|x, y| x.1.total_cmp(&y.1))
-            .map(|(other, lift)| {
-                format!(
-                    "its pair with {} was accepted at wall lift {lift:.3}, below --min-lift {}: \
-                     --min-lift {} uses it",
-                    args.maps[other].display(),
-                    args.min_lift,
-                    (lift * 100.0).floor() / 100.0
-                )
-            })
+        let (lift, via) = chains[k]?;
+        let bar = (lift * 100.0).floor() / 100.0;
+        if groups[reference].contains(&via) {
+            return Some(format!(
+                "its pair with {} was accepted at wall lift {lift:.3}, below --min-lift {}: \
+                 --min-lift {bar} uses it",
+                args.maps[via].display(),
+                args.min_lift,
+            ));
+        }
+        // The maps between it and the reference's, nearest first.
+        let mut between = Vec::new();
+        let mut m = via;
+        while !groups[reference].contains(&m) && between.len() < args.maps.len() {
+            between.push(m);
+            m = chains[m]?.1;
+        }
+        Some(format!(
+            "pairs accepted at wall lift {lift:.3} or more link it to {} through {}: \
+             --min-lift {bar} places it",
+            args.maps[m].display(),
+            names(&args.maps, &between),
+        ))
     };
     let mut map_reports: Vec<Value> = args
         .maps
@@ -350,6 +362,17 @@ pub fn run(args: &MergeArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode> {
                 "every pair with it was declined".to_string()
             }
         );
+        // The bar that would place every map that accepted pairs link to the reference.
+        let reached: Vec<f64> = chains.iter().flatten().map(|&(lift, _)| lift).collect();
+        if let Some(lowest) = reached.iter().copied().reduce(f64::min) {
+            let bar = (lowest * 100.0).floor() / 100.0;
+            reason.push_str(&match reached.len() {
+                1 => format!("; --min-lift {bar} places the map that accepted pairs link to it"),
+                n => {
+                    format!("; --min-lift {bar} places the {n} maps that accepted pairs link to it")
+                }
+            });
+        }
         // The largest group of maps linked to each other, the earliest first on a tie.
         if let Some(hint) = (0..args.maps.len())
             .filter(|&k| groups[k][0] == k)
@@ -444,6 +467,47 @@ fn linked_groups(n: usize, pairs: &[TeamPair], status: &[EdgeStatus]) -> Vec<Vec
     (0..n)
         .map(|k| (0..n).filter(|&j| roots[j] == roots[k]).collect())
         .collect()
+}
+
+/// Per map outside `linked` (the maps placed with the reference), the highest `--min-lift` at
+/// which accepted pairs would link it to them, and the map before it on that chain: over every
+/// chain of accepted pairs from a map of `linked` to it, the lowest wall lift along the chain,
+/// highest first (the widest path). `None` for the maps of `linked` and for those that no
+/// chain of accepted pairs reaches.
+///
+/// `lifts` holds each accepted pair as `(a, b, wall lift)`.
+fn widest_chains(
+    n: usize,
+    lifts: &[(usize, usize, f64)],
+    linked: &[usize],
+) -> Vec<Option<(f64, usize)>> {
+    let mut best: Vec<Option<(f64, usize)>> = (0..n)
+        .map(|k| linked.contains(&k).then_some((f64::INFINITY, k)))
+        .collect();
+    // Each pass can only raise a map's lowest lift, to one of the pairs' lifts: at most n
+    // passes change anything.
+    for _ in 0..n {
+        let mut changed = false;
+        for &(a, b, lift) in lifts {
+            for (from, to) in [(a, b), (b, a)] {
+                let Some((reach, _)) = best[from] else {
+                    continue;
+                };
+                let reach = reach.min(lift);
+                if best[to].is_none_or(|(old, _)| reach > old) {
+                    best[to] = Some((reach, from));
+                    changed = true;
+                }
+            }
+        }
+        if !changed {
+            break;
+        }
+    }
+    for &k in linked {
+        best[k] = None;
+    }
+    best
 }
 
 /// The maps `group` as a list in words: `a`, `a and b`, `a, b and c`.
@@ -749,4 +813,39 @@ fn write_picture(path: &Path, fused: &FusedMap) -> anyhow::Result<()> {
     img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
         .map_err(|e| anyhow::anyhow!("{}: cannot encode the picture: {e}", path.display()))?;
     write_atomic(path, &png).context("cannot write the picture")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_map_is_reached_by_the_chain_whose_lowest_lift_is_highest() {
+        // 0 is linked. 3 is reached through 1 (lowest lift 0.5) or through 2 (0.6): 2 wins.
+        // 4 is reached only through 3. 5 has no accepted pair.
+        let lifts = [
+            (0, 1, 0.7),
+            (1, 3, 0.5),
+            (0, 2, 0.6),
+            (2, 3, 0.65),
+            (3, 4, 0.9),
+        ];
+        let chains = widest_chains(6, &lifts, &[0]);
+        assert_eq!(
+            chains,
+            [
+                None,
+                Some((0.7, 0)),
+                Some((0.6, 0)),
+                Some((0.6, 2)),
+                Some((0.6, 3)),
+                None
+            ]
+        );
+        // Maps already linked get no chain; a pair between two of them changes nothing.
+        let chains = widest_chains(6, &lifts, &[0, 1, 2]);
+        assert_eq!(chains[..3], [None, None, None]);
+        assert_eq!(chains[3], Some((0.65, 2)));
+        assert_eq!(chains[4], Some((0.65, 3)));
+    }
 }
