@@ -398,6 +398,16 @@ fn statuses(report: &serde_json::Value) -> Vec<&str> {
         .collect()
 }
 
+/// Whether each map of a merge report was merged, in the report's order.
+fn merged_flags(report: &serde_json::Value) -> Vec<bool> {
+    report["maps"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| m["merged"].as_bool().unwrap())
+        .collect()
+}
+
 #[test]
 fn a_map_that_shares_nothing_with_the_first_is_placed_through_another() {
     let dir = TempDir::new().unwrap();
@@ -470,17 +480,20 @@ fn a_map_that_shares_nothing_with_the_first_is_placed_through_another() {
 
     // With the lift bar at 1, the two accepted pairs are set aside as weak: no map is linked
     // to the first, so nothing is written (exit 3).
+    let with_bar = |out: &Path, bar: &str| {
+        merge(&[
+            s(&a),
+            s(&b),
+            s(&c),
+            "-o",
+            s(out),
+            "--json",
+            "--min-lift",
+            bar,
+        ])
+    };
     let out = dir.path().join("weak.yaml");
-    let o = merge(&[
-        s(&a),
-        s(&b),
-        s(&c),
-        "-o",
-        s(&out),
-        "--json",
-        "--min-lift",
-        "1",
-    ]);
+    let o = with_bar(&out, "1");
     assert_eq!(o.status.code(), Some(3));
     let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(statuses(&report), ["weak", "declined", "weak"], "{report}");
@@ -525,27 +538,10 @@ fn a_map_that_shares_nothing_with_the_first_is_placed_through_another() {
         )
     );
     // That bar does place both.
-    let out = dir.path().join("chain.yaml");
-    let min_lift = bar(chain).to_string();
-    let o = merge(&[
-        s(&a),
-        s(&b),
-        s(&c),
-        "-o",
-        s(&out),
-        "--json",
-        "--min-lift",
-        &min_lift,
-    ]);
+    let o = with_bar(&dir.path().join("chain.yaml"), &bar(chain).to_string());
     assert_eq!(o.status.code(), Some(0));
     let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-    let merged: Vec<bool> = report["maps"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|m| m["merged"].as_bool().unwrap())
-        .collect();
-    assert_eq!(merged, [true, true, true], "{report}");
+    assert_eq!(merged_flags(&report), [true, true, true], "{report}");
 }
 
 #[test]
@@ -572,13 +568,7 @@ fn a_map_that_overlaps_no_other_is_left_out_or_nothing_is_written() {
         )
     );
     let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-    let merged: Vec<bool> = report["maps"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|m| m["merged"].as_bool().unwrap())
-        .collect();
-    assert_eq!(merged, [true, true, false]);
+    assert_eq!(merged_flags(&report), [true, true, false]);
     assert!(report["maps"][2]["transform"].is_null());
     assert!(out.exists() && out.with_extension("pgm").exists());
 
