@@ -1,14 +1,19 @@
 //! How far the walls of simulated maps sit from the true obstacle faces, by distance to the
 //! robot's path: the range bias that `mapmerge::refine::RefineConfig::range_bias` models.
 //!
-//! `cargo run --release -p mapsim --example wall_bias -- [NOISE] [OVERLAP] [CASES]`
-//! (defaults 0.1, 0.3, 4) generates disaster-area cases like the `overlap` suite of `cargo
-//! xtask eval` at seed 7 and prints, per 10-cell band of distance from the nearest pose of the
-//! path, the mean signed offset of the maps' occupied cells from the nearest face of the world
-//! (positive: inside the obstacle, away from the robot) and the share farther than 3 cells.
+//! `cargo run --release -p mapsim --example wall_bias -- [NOISE] [OVERLAP] [CASES] [MAPPER]`
+//! (defaults 0.1, 0.3, 4, default) generates disaster-area cases like the `overlap` suite of
+//! `cargo xtask eval` at seed 7 and prints, per 10-cell band of distance from the nearest pose
+//! of the path, the mean signed offset of the maps' occupied cells from the nearest face of the
+//! world (positive: inside the obstacle, away from the robot) and the share farther than 3
+//! cells. MAPPER is one of `cargo xtask eval --mapper`'s: default, hector, gmapping,
+//! slam-toolbox (OctoMap's is `cargo xtask`'s alone).
 
 use grid_core::{CellState, DVec2};
-use mapsim::{CaseConfig, RobotConfig, WorldConfig, generate_case};
+use mapsim::{
+    CaseConfig, HitRatioModel, InverseSensorModel, MapperModel, RobotConfig, WorldConfig,
+    generate_case,
+};
 
 /// Faces farther than this from a wall cell are not looked for.
 const REACH: i64 = 15;
@@ -21,6 +26,14 @@ fn main() {
             .unwrap_or(default)
     };
     let (noise, overlap, cases) = (arg(1, 0.1), arg(2, 0.3), arg(3, 4.0) as u64);
+    let name = std::env::args().nth(4).unwrap_or_else(|| "default".into());
+    let mapper: MapperModel = match name.as_str() {
+        "default" => InverseSensorModel::default().into(),
+        "hector" => InverseSensorModel::hector().into(),
+        "gmapping" => HitRatioModel::gmapping().into(),
+        "slam-toolbox" => HitRatioModel::slam_toolbox().into(),
+        other => panic!("unknown mapper {other}: default, hector, gmapping or slam-toolbox"),
+    };
     let lidar = RobotConfig {
         noise_bound: noise,
         ..RobotConfig::default()
@@ -30,6 +43,7 @@ fn main() {
         robots: vec![lidar.clone(), lidar],
         overlap,
         overlap_tolerance: f64::INFINITY,
+        mapper,
         ..CaseConfig::default()
     };
     // Per band: sum of offsets, cells, cells off by more than 3.
@@ -74,7 +88,9 @@ fn main() {
             }
         }
     }
-    println!("noise {noise}, overlap {overlap}, {cases} cases (seed 7 of the overlap suite)");
+    println!(
+        "noise {noise}, overlap {overlap}, {cases} cases (seed 7 of the overlap suite), {name} mapper"
+    );
     for (i, &(sum, n, far)) in bands.iter().enumerate() {
         if n > 0 {
             println!(
