@@ -290,7 +290,7 @@ pub fn run(args: &MergeArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode> {
     let chains = widest_chains(args.maps.len(), &lifts, &groups[reference]);
     let weak_way_in = |k: usize| -> Option<String> {
         let (lift, via) = chains[k]?;
-        let bar = (lift * 100.0).floor() / 100.0;
+        let bar = bar_at(lift);
         if groups[reference].contains(&via) {
             return Some(format!(
                 "its pair with {} was accepted at wall lift {lift:.3}, below --min-lift {}: \
@@ -365,7 +365,7 @@ pub fn run(args: &MergeArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode> {
         // The bar that would place every map that accepted pairs link to the reference.
         let reached: Vec<f64> = chains.iter().flatten().map(|&(lift, _)| lift).collect();
         if let Some(lowest) = reached.iter().copied().reduce(f64::min) {
-            let bar = (lowest * 100.0).floor() / 100.0;
+            let bar = bar_at(lowest);
             reason.push_str(&match reached.len() {
                 1 => format!("; --min-lift {bar} places the map that accepted pairs link to it"),
                 n => {
@@ -467,6 +467,12 @@ fn linked_groups(n: usize, pairs: &[TeamPair], status: &[EdgeStatus]) -> Vec<Vec
     (0..n)
         .map(|k| (0..n).filter(|&j| roots[j] == roots[k]).collect())
         .collect()
+}
+
+/// The `--min-lift` that uses a pair accepted at wall lift `lift`: the lift rounded down to
+/// hundredths, at least 0 (the flag's range).
+fn bar_at(lift: f64) -> f64 {
+    ((lift * 100.0).floor() / 100.0).max(0.0)
 }
 
 /// Per map outside `linked` (the maps placed with the reference), the highest `--min-lift` at
