@@ -476,10 +476,10 @@ fn bar_at(lift: f64) -> f64 {
 }
 
 /// Per map outside `linked` (the maps placed with the reference), the highest `--min-lift` at
-/// which accepted pairs would link it to them, and the map before it on that chain: over every
-/// chain of accepted pairs from a map of `linked` to it, the lowest wall lift along the chain,
-/// highest first (the widest path). `None` for the maps of `linked` and for those that no
-/// chain of accepted pairs reaches.
+/// which accepted pairs would link it to them, and the map before it on that chain. Of every
+/// chain of accepted pairs from a map of `linked` to it, the one whose lowest wall lift is
+/// highest (the widest path) gives that lowest lift. `None` for the maps of `linked` and for
+/// those that no chain of accepted pairs reaches.
 ///
 /// `lifts` holds each accepted pair as `(a, b, wall lift)`.
 fn widest_chains(
