@@ -681,6 +681,15 @@ pub fn mean_apart(points: &[DVec2], x: &Rigid2, y: &Rigid2) -> f64 {
         / points.len().max(1) as f64
 }
 
+/// The pixels of `grid`'s occupied cells, row by row.
+fn wall_cells(grid: &OccupancyGrid) -> Vec<DVec2> {
+    (0..grid.height())
+        .flat_map(|y| (0..grid.width()).map(move |x| (x, y)))
+        .filter(|&(x, y)| grid.state(x, y) == CellState::Occupied)
+        .map(|(x, y)| DVec2::new(x as f64, y as f64))
+        .collect()
+}
+
 impl Registration {
     /// The best-ranked candidate after the first that places `b` (the map registered onto A,
     /// in its own pixels, as the candidates' transforms are) more than `distinct_px` apart from
@@ -695,11 +704,7 @@ impl Registration {
     /// in free space and whether the two are one broad optimum).
     pub fn runner_up(&self, b: &OccupancyGrid, distinct_px: f64) -> Option<RunnerUp> {
         let first = self.candidates.first()?;
-        let walls: Vec<DVec2> = (0..b.height())
-            .flat_map(|y| (0..b.width()).map(move |x| (x, y)))
-            .filter(|&(x, y)| b.state(x, y) == CellState::Occupied)
-            .map(|(x, y)| DVec2::new(x as f64, y as f64))
-            .collect();
+        let walls = wall_cells(b);
         if walls.is_empty() {
             return None;
         }
@@ -2275,12 +2280,7 @@ mod tests {
             candidates: vec![placed(0.0, 0.9, true), turned],
             ..r
         };
-        let walls: Vec<DVec2> = (0..b.height())
-            .flat_map(|y| (0..b.width()).map(move |x| (x, y)))
-            .filter(|&(x, y)| b.state(x, y) == CellState::Occupied)
-            .map(|(x, y)| DVec2::new(x as f64, y as f64))
-            .collect();
-        let probe = crate::verify::strided(&walls, APART_POINTS);
+        let probe = crate::verify::strided(&wall_cells(&b), APART_POINTS);
         let expected =
             probe.iter().map(|p| 2.0 * (*p - c).length()).sum::<f64>() / probe.len() as f64;
         let u = r.runner_up(&b, 10.0).unwrap();
