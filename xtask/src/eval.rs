@@ -160,6 +160,10 @@ pub struct EvalArgs {
     /// Turn the stand-out rule off.
     #[arg(long)]
     no_stand_out: bool,
+    /// Turn off the clean successor of a declined best (`mapmerge::verify::CleanSuccessor`),
+    /// to measure what it changes.
+    #[arg(long)]
+    no_clean_successor: bool,
     /// Do not sweep the other way round when nothing passed (`reverse` of
     /// `mapmerge::global::SweepConfig`), to measure what it changes.
     #[arg(long)]
@@ -1094,6 +1098,9 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
         &mut verify.min_crisp_contradiction,
         args.min_crisp_contradiction,
     );
+    if args.no_clean_successor {
+        verify.clean_successor = None;
+    }
     if args.no_stand_out {
         verify.stand_out = None;
     }

@@ -336,6 +336,15 @@ impl VerifyConfig {
                 ],
             )?;
         }
+        if let Some(c) = &self.clean_successor {
+            Fields(&f.path("clean_successor")).all(
+                Rule::NotNan,
+                &[
+                    ("min_wide_wall_lift", c.min_wide_wall_lift),
+                    ("max_mutual_contradiction", c.max_mutual_contradiction),
+                ],
+            )?;
+        }
         if let Some(c) = &self.clean_walls {
             Fields(&f.path("clean_walls")).all(
                 Rule::NotNan,
@@ -545,6 +554,25 @@ mod tests {
             ("pair.verify.basin_ratio", |c| {
                 c.pair.verify.basin_ratio = f64::NAN
             }),
+            ("pair.verify.clean_successor.min_wide_wall_lift", |c| {
+                c.pair
+                    .verify
+                    .clean_successor
+                    .as_mut()
+                    .unwrap()
+                    .min_wide_wall_lift = f64::NAN
+            }),
+            (
+                "pair.verify.clean_successor.max_mutual_contradiction",
+                |c| {
+                    c.pair
+                        .verify
+                        .clean_successor
+                        .as_mut()
+                        .unwrap()
+                        .max_mutual_contradiction = f64::NAN
+                },
+            ),
             ("pair.verify.stand_out.min_wide_wall_lift", |c| {
                 c.pair.verify.stand_out.as_mut().unwrap().min_wide_wall_lift = f64::NAN
             }),

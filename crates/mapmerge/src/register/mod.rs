@@ -217,8 +217,10 @@ pub struct RunnerUp {
     /// to [`APART_POINTS`] of B's wall cells ([`mean_apart`]).
     pub apart_px: f64,
     /// Its [`Verification::score`] over the answer's (0 when the answer scores 0). It can
-    /// exceed 1: the ranking puts the placements that pass the bars first, and the answer's
-    /// pose is refined after the ranking.
+    /// exceed 1: the ranking puts the placements that pass the bars first, the answer's pose is
+    /// refined after the ranking, and a placement that fits cleanly can succeed a best that
+    /// scored more but put walls in the other map's free space
+    /// ([`VerifyConfig::clean_successor`](crate::verify::VerifyConfig::clean_successor)).
     pub score_ratio: f64,
 }
 

@@ -13,8 +13,9 @@ use ransac_rigid::estimate_rigid;
 
 use super::{
     APART_POINTS, Candidate, KindTotals, Origin, PairConfig, Placement, Registration, Timings,
-    at_angle, fits_about_as_well, manhattan_rotation_near, mean_apart, ms, one_basin,
-    refine_and_score, rivals, screen, standing_out, stands_out, unverified_reason, wall_centres,
+    at_angle, contradiction_excess, fits_about_as_well, manhattan_rotation_near, mean_apart, ms,
+    one_basin, refine_and_score, rivals, screen, standing_out, stands_out, unverified_reason,
+    wall_centres,
 };
 use crate::ascent::{ascend, frontier_ratio, lone_wall_share, wall_thickness};
 use crate::global::{global_hypotheses, spectrum_rotation_near, sweep_placements, twins};
@@ -94,7 +95,9 @@ pub(super) fn register_as_given(
     run.whole_map_searches(&mut candidates, &mut timings);
     run.rank(&mut candidates);
     run.settle_answer(&mut candidates, &mut timings);
-    if let Some(reason) = run.declined_answer(&candidates) {
+    if let Some(reason) = run.declined_answer(&candidates)
+        && !run.succeed(&mut candidates, &mut timings)
+    {
         return declined(reason, timings, candidates);
     }
     match candidates.first() {
@@ -553,6 +556,56 @@ impl<'m> PairRun<'m> {
         self.climb(candidates, timings);
     }
 
+    /// The best-ranked candidate that may succeed the declined best (see
+    /// [`crate::verify::CleanSuccessor`]), refined if it was not; its index.
+    fn successor(&self, candidates: &mut [Candidate]) -> Option<usize> {
+        let verify = &self.config.verify;
+        let rule = verify.clean_successor.as_ref()?;
+        let best = candidates.first().filter(|b| b.accepted)?.clone();
+        let succeeds = |c: &Candidate| {
+            let v = &c.verification;
+            c.accepted
+                && rule.fits_cleanly(v)
+                && v.score() >= verify.max_ambiguity * best.verification.score()
+                && best.verification.wall_contradiction
+                    > v.wall_contradiction + contradiction_excess(v, verify)
+                && self.apart(&c.transform, &best.transform) > verify.distinct_px
+        };
+        for (i, c) in candidates.iter_mut().enumerate().skip(1) {
+            if !succeeds(c) {
+                continue;
+            }
+            if !c.refined {
+                self.settle(c);
+                if !succeeds(c) {
+                    continue;
+                }
+            }
+            return Some(i);
+        }
+        None
+    }
+
+    /// The declined best succeeded by a clean placement, if one may succeed it (see
+    /// [`crate::verify::CleanSuccessor`]): it is put first, its pose settled by the answer's
+    /// stages, and it must pass the answer's bars. Whether it did; if not, `candidates` are
+    /// left as they were.
+    fn succeed(&self, candidates: &mut Vec<Candidate>, timings: &mut Timings) -> bool {
+        let before = candidates.clone();
+        let Some(i) = self.successor(candidates) else {
+            *candidates = before;
+            return false;
+        };
+        let successor = candidates.remove(i);
+        candidates.insert(0, successor);
+        self.refine_answer(candidates, timings);
+        if self.declined_answer(candidates).is_some() {
+            *candidates = before;
+            return false;
+        }
+        true
+    }
+
     /// The best candidate, when clean, is polished (only the best: on the 2048 bench pair
     /// polishing every RANSAC candidate cost about 35 ms).
     fn polish(&self, candidates: &mut [Candidate]) {
@@ -747,7 +800,7 @@ impl<'m> PairRun<'m> {
                     (best.transform, best.verification) = (t, v);
                 }
             }
-            timings.ascent_ms = ms(t0);
+            timings.ascent_ms += ms(t0);
         }
     }
 
