@@ -438,13 +438,8 @@ impl<'m> PairRun<'m> {
             let (found, t) = self.search(&|out| out.extend(self.swept(false)), Origin::Sweep);
             candidates.extend(found);
             timings.sweep_ms = t;
-            // Nothing passed, or the best that passed would be declined (walls in the other
-            // map's free space, a rival): the other way round (see `SweepConfig::reverse`).
-            if sweep.reverse && {
-                self.rank(candidates);
-                !candidates.first().is_some_and(|c| c.accepted)
-                    || self.declined_answer(candidates).is_some()
-            } {
+            // Nothing passed: the other way round (see `SweepConfig::reverse`).
+            if sweep.reverse && !candidates.iter().any(|c| c.accepted) {
                 let (found, t) = self.search(&|out| out.extend(self.swept(true)), Origin::Sweep);
                 candidates.extend(found);
                 timings.sweep_ms += t;
