@@ -164,8 +164,8 @@ pub struct EvalArgs {
     /// to measure what it changes.
     #[arg(long)]
     no_clean_successor: bool,
-    /// Do not sweep the other way round when nothing passed (`reverse` of
-    /// `mapmerge::global::SweepConfig`), to measure what it changes.
+    /// Do not sweep the other way round when nothing passed or the best that passed would be
+    /// declined (`reverse` of `mapmerge::global::SweepConfig`), to measure what it changes.
     #[arg(long)]
     no_reverse_sweep: bool,
     /// Override how far from a wall unknown cells count as known where walls are compared

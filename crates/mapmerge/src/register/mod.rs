@@ -1,4 +1,7 @@
 //! Registration of one pair: correspondences → RANSAC hypotheses → refinement → verification.
+//!
+//! `pair.rs` runs the stages, each a method of its `PairRun`; `config.rs` holds the settings;
+//! this file the types of the answer and the helpers the stages share.
 
 use std::time::Instant;
 

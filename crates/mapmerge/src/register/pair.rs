@@ -438,8 +438,14 @@ impl<'m> PairRun<'m> {
             let (found, t) = self.search(&|out| out.extend(self.swept(false)), Origin::Sweep);
             candidates.extend(found);
             timings.sweep_ms = t;
-            // Nothing passed: the other way round (see `SweepConfig::reverse`).
-            if sweep.reverse && !candidates.iter().any(|c| c.accepted) {
+            // Nothing passed, or the best that passed would be declined (walls in the other
+            // map's free space, a misfit, a rival): the other way round (see
+            // `SweepConfig::reverse`).
+            if sweep.reverse && {
+                self.rank(candidates);
+                !candidates.first().is_some_and(|c| c.accepted)
+                    || self.declined_answer(candidates).is_some()
+            } {
                 let (found, t) = self.search(&|out| out.extend(self.swept(true)), Origin::Sweep);
                 candidates.extend(found);
                 timings.sweep_ms += t;
@@ -704,7 +710,7 @@ impl<'m> PairRun<'m> {
             let (sa, sb) = self.lone_shares();
             if fit.falls_short(v.wide_wall_lift, sa, sb) {
                 return Some(format!(
-                    "misfit: both maps draw their walls cleanly (lone wall cells {:.1} % and {:.1} %), where a right placement fits its walls at wide lift {:.2} or more; the best fits at {:.2}",
+                    "misfit: both maps draw their walls cleanly (lone wall cells {:.1} % and {:.1} %), where a right placement fits its walls at wide lift {:.2} or more; the best fits at {:.3}",
                     100.0 * sa,
                     100.0 * sb,
                     fit.min_wide_wall_lift,
@@ -869,7 +875,7 @@ impl<'m> PairRun<'m> {
             && small.falls_short(v)
         {
             return Some(format!(
-                "sliver: the best placement shares {:.0} % of the smaller map's known cells, and an overlap under {:.0} % is accepted only where the walls fit almost everywhere (wide wall lift {:.2} or more; this one {:.2})",
+                "sliver: the best placement shares {:.0} % of the smaller map's known cells, and an overlap under {:.0} % is accepted only where the walls fit almost everywhere (wide wall lift {:.2} or more; this one {:.3})",
                 100.0 * v.overlap_fraction,
                 100.0 * small.below,
                 small.min_wide_wall_lift,
