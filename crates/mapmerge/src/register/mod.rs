@@ -412,10 +412,10 @@ pub const SPECKLED_LONE_SHARE: f64 = 0.1;
 /// with strong noise leaves.
 fn unverified_reason(v: &Verification, config: &VerifyConfig, lone: (f64, f64)) -> String {
     let mut reason = format!(
-        "no hypothesis passed verification (best: wall lift {:.2} where {:.2} passes, or {:.2} at {} px where {:.2} passes; acceptance index {:.2}; overlap {:.1}% of the smaller map)",
-        v.wall_lift,
+        "no hypothesis passed verification (best: wall lift {} where {:.2} passes, or {} at {} px where {:.2} passes; acceptance index {:.2}; overlap {:.1}% of the smaller map)",
+        short_of(v.wall_lift, config.min_wall_lift),
         config.min_wall_lift,
-        v.wide_wall_lift,
+        short_of(v.wide_wall_lift, config.min_wide_wall_lift),
         config.wide_tolerance_px,
         config.min_wide_wall_lift,
         v.acceptance_index,
@@ -429,6 +429,17 @@ fn unverified_reason(v: &Verification, config: &VerifyConfig, lone: (f64, f64)) 
         );
     }
     reason
+}
+
+/// `value`, measured against a `bar` it may fall short of, for a decline's reason: to two
+/// decimals as the bars are printed, or to as many more (up to five) as it takes not to read
+/// as the bar itself when it falls short of it (0.8774 against 0.88 is "0.877", not "0.88").
+pub(crate) fn short_of(value: f64, bar: f64) -> String {
+    let shown = |d: usize| format!("{value:.d$}");
+    (2..=5)
+        .map(shown)
+        .find(|s| value >= bar || s.parse::<f64>().is_ok_and(|v| v < bar))
+        .unwrap_or_else(|| shown(5))
 }
 
 fn ms(t: Instant) -> f64 {

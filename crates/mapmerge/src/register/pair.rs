@@ -14,8 +14,8 @@ use ransac_rigid::estimate_rigid;
 use super::{
     APART_POINTS, Candidate, KindTotals, Origin, PairConfig, Placement, Registration, Timings,
     at_angle, contradiction_excess, fits_about_as_well, manhattan_rotation_near, mean_apart, ms,
-    one_basin, refine_and_score, rivals, screen, standing_out, stands_out, unverified_reason,
-    wall_centres,
+    one_basin, refine_and_score, rivals, screen, short_of, standing_out, stands_out,
+    unverified_reason, wall_centres,
 };
 use crate::ascent::{ascend, frontier_ratio, lone_wall_share, wall_thickness};
 use crate::global::{global_hypotheses, spectrum_rotation_near, sweep_placements, twins};
@@ -710,11 +710,11 @@ impl<'m> PairRun<'m> {
             let (sa, sb) = self.lone_shares();
             if fit.falls_short(v.wide_wall_lift, sa, sb) {
                 return Some(format!(
-                    "misfit: both maps draw their walls cleanly (lone wall cells {:.1} % and {:.1} %), where a right placement fits its walls at wide lift {:.2} or more; the best fits at {:.3}",
+                    "misfit: both maps draw their walls cleanly (lone wall cells {:.1} % and {:.1} %), where a right placement fits its walls at wide lift {:.2} or more; the best fits at {}",
                     100.0 * sa,
                     100.0 * sb,
                     fit.min_wide_wall_lift,
-                    v.wide_wall_lift
+                    short_of(v.wide_wall_lift, fit.min_wide_wall_lift)
                 ));
             }
         }
@@ -875,11 +875,11 @@ impl<'m> PairRun<'m> {
             && small.falls_short(v)
         {
             return Some(format!(
-                "sliver: the best placement shares {:.0} % of the smaller map's known cells, and an overlap under {:.0} % is accepted only where the walls fit almost everywhere (wide wall lift {:.2} or more; this one {:.3})",
+                "sliver: the best placement shares {:.0} % of the smaller map's known cells, and an overlap under {:.0} % is accepted only where the walls fit almost everywhere (wide wall lift {:.2} or more; this one {})",
                 100.0 * v.overlap_fraction,
                 100.0 * small.below,
                 small.min_wide_wall_lift,
-                v.wide_wall_lift
+                short_of(v.wide_wall_lift, small.min_wide_wall_lift)
             ));
         }
         if v.too_small(&config.verify) {

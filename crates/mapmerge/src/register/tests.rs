@@ -187,6 +187,26 @@ fn a_decline_names_the_bars_missed_and_speckle_where_both_maps_have_it() {
 }
 
 #[test]
+fn a_value_short_of_its_bar_never_reads_as_the_bar() {
+    assert_eq!(short_of(0.42, 0.65), "0.42");
+    assert_eq!(short_of(0.8774, 0.88), "0.877");
+    assert_eq!(short_of(0.87996, 0.88), "0.87996");
+    assert_eq!(short_of(0.881, 0.88), "0.88");
+    assert_eq!(short_of(0.9, 0.88), "0.90");
+    let v = Verification {
+        wall_lift: 0.6496,
+        wide_wall_lift: 0.7999,
+        acceptance_index: 0.85,
+        overlap_fraction: 0.2,
+        ..Verification::default()
+    };
+    assert_eq!(
+        unverified_reason(&v, &VerifyConfig::default(), (0.01, 0.01)),
+        "no hypothesis passed verification (best: wall lift 0.6496 where 0.65 passes, or 0.7999 at 4 px where 0.80 passes; acceptance index 0.85; overlap 20.0% of the smaller map)"
+    );
+}
+
+#[test]
 fn the_turn_scan_tries_each_step_both_ways_nearest_first() {
     let deg = |v: &[f64]| -> Vec<f64> {
         v.iter()
