@@ -159,6 +159,54 @@ fn the_runner_up_is_reported_with_how_far_it_lies_from_the_answer() {
     );
 }
 
+/// A declined pair's text form names the best placement it declined and where else the maps
+/// fit, as the JSON's `best_rejected` and `runner_up` do.
+#[test]
+fn a_declined_pair_shows_the_placement_it_declined_and_the_runner_up() {
+    let (a, b) = (fixture("wpi_ilab"), fixture("tb3_world"));
+    let v = json(&run(&[&a, &b]));
+    let text = Command::new(env!("CARGO_BIN_EXE_mapmerge"))
+        .args([Path::new("estimate"), &a, &b])
+        .output()
+        .unwrap();
+    assert_eq!(text.status.code(), Some(3));
+    let text = String::from_utf8(text.stdout).unwrap();
+    let line = |start: &str| {
+        text.lines()
+            .find(|l| l.starts_with(start))
+            .unwrap_or_else(|| panic!("no line {start:?} in {text}"))
+            .to_string()
+    };
+    let f = |x: &serde_json::Value| x.as_f64().unwrap();
+    let (t, bv) = (
+        &v["best_rejected"]["transform"],
+        &v["best_rejected"]["verification"],
+    );
+    assert_eq!(
+        line("best placement, declined: "),
+        format!(
+            "best placement, declined: theta {:.3} deg, tx {:.2} px, ty {:.2} px; wall lift {:.2} (at 4 px {:.2}), acceptance index {:.3}, overlap {:.1}% of the smaller map, {:.1} % of its compared walls in the other map's free space",
+            f(&t["theta"]).to_degrees(),
+            f(&t["tx"]),
+            f(&t["ty"]),
+            f(&bv["wall_lift"]),
+            f(&bv["wide_wall_lift"]),
+            f(&bv["acceptance_index"]),
+            100.0 * f(&bv["overlap_fraction"]),
+            100.0 * f(&bv["wall_contradiction"])
+        )
+    );
+    let u = &v["runner_up"];
+    let runner_up = line("runner-up: ");
+    assert!(
+        runner_up.contains(&format!(
+            "{:.0} px from the best placement",
+            f(&u["apart_px"])
+        )) && runner_up.contains(&format!("score {:.2} of the best's", f(&u["score_ratio"]))),
+        "{runner_up} against {u}"
+    );
+}
+
 #[test]
 fn unrelated_maps_are_declined_with_exit_3() {
     for (a, b) in [("wpi_ilab", "tb3_world"), ("aws_small_house", "wpi_ilab")] {

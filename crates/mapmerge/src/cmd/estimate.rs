@@ -41,6 +41,8 @@ Output (--json): one JSON object on stdout.
                    hypothesis: where else the maps fit, and how well. One that passes and
                    fits about as well as the answer (0.6 of its score or more) mostly makes
                    the pair ambiguous, and declined
+  best_rejected    of a declined pair: the best-ranked placement, declined (transform,
+                   verification); its runner_up is measured from it
   method, hypothesis (ransac, global, sweep or symmetry), correspondences, candidates, timings_ms
 
 Exit codes: 0 transform found, 3 no trustworthy match (the pair is declined), 2 bad usage or
@@ -185,12 +187,29 @@ fn report(
 
 fn human(w: &mut impl Write, o: &serde_json::Value) -> std::io::Result<()> {
     let f = |k: &str| o[k].as_f64().unwrap_or(f64::NAN);
-    if o["transform"].is_null() {
+    let declined = o["transform"].is_null();
+    if declined {
         writeln!(
             w,
             "no trustworthy match: {}",
             o["reason"].as_str().unwrap_or("?")
         )?;
+        let best = &o["best_rejected"];
+        if !best.is_null() {
+            let (t, v) = (&best["transform"], &best["verification"]);
+            writeln!(
+                w,
+                "best placement, declined: theta {:.3} deg, tx {:.2} px, ty {:.2} px; wall lift {:.2} (at 4 px {:.2}), acceptance index {:.3}, overlap {:.1}% of the smaller map, {:.1} % of its compared walls in the other map's free space",
+                t["theta"].as_f64().unwrap_or(0.0).to_degrees(),
+                t["tx"].as_f64().unwrap_or(0.0),
+                t["ty"].as_f64().unwrap_or(0.0),
+                v["wall_lift"].as_f64().unwrap_or(0.0),
+                v["wide_wall_lift"].as_f64().unwrap_or(0.0),
+                v["acceptance_index"].as_f64().unwrap_or(0.0),
+                100.0 * v["overlap_fraction"].as_f64().unwrap_or(0.0),
+                100.0 * v["wall_contradiction"].as_f64().unwrap_or(0.0)
+            )?;
+        }
     } else {
         let t = &o["transform"];
         let wd = &o["world"];
@@ -225,26 +244,33 @@ fn human(w: &mut impl Write, o: &serde_json::Value) -> std::io::Result<()> {
                 v["wide_wall_lift"].as_f64().unwrap_or(0.0)
             )?;
         }
-        let u = &o["runner_up"];
-        if !u.is_null() {
-            let (t, uv) = (&u["transform"], &u["verification"]);
-            writeln!(
-                w,
-                "runner-up: theta {:.3} deg, tx {:.2} px, ty {:.2} px, {:.0} px from the answer (mean over B's walls); wall lift {:.2} (at 4 px {:.2}), score {:.2} of the answer's, {}",
-                t["theta"].as_f64().unwrap_or(0.0).to_degrees(),
-                t["tx"].as_f64().unwrap_or(0.0),
-                t["ty"].as_f64().unwrap_or(0.0),
-                u["apart_px"].as_f64().unwrap_or(0.0),
-                uv["wall_lift"].as_f64().unwrap_or(0.0),
-                uv["wide_wall_lift"].as_f64().unwrap_or(0.0),
-                u["score_ratio"].as_f64().unwrap_or(0.0),
-                if u["passes"].as_bool() == Some(true) {
-                    "passing the bars"
-                } else {
-                    "below the bars"
-                }
-            )?;
-        }
+    }
+    // Where else the maps fit: beside the answer, or beside the declined best (an ambiguous
+    // pair's rival, say).
+    let u = &o["runner_up"];
+    if !u.is_null() {
+        let (t, uv) = (&u["transform"], &u["verification"]);
+        let (from, of) = if declined {
+            ("the best placement", "the best's")
+        } else {
+            ("the answer", "the answer's")
+        };
+        writeln!(
+            w,
+            "runner-up: theta {:.3} deg, tx {:.2} px, ty {:.2} px, {:.0} px from {from} (mean over B's walls); wall lift {:.2} (at 4 px {:.2}), score {:.2} of {of}, {}",
+            t["theta"].as_f64().unwrap_or(0.0).to_degrees(),
+            t["tx"].as_f64().unwrap_or(0.0),
+            t["ty"].as_f64().unwrap_or(0.0),
+            u["apart_px"].as_f64().unwrap_or(0.0),
+            uv["wall_lift"].as_f64().unwrap_or(0.0),
+            uv["wide_wall_lift"].as_f64().unwrap_or(0.0),
+            u["score_ratio"].as_f64().unwrap_or(0.0),
+            if u["passes"].as_bool() == Some(true) {
+                "passing the bars"
+            } else {
+                "below the bars"
+            }
+        )?;
     }
     let t = &o["timings_ms"];
     let total: f64 = [
