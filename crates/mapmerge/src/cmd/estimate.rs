@@ -185,6 +185,17 @@ fn report(
     out
 }
 
+/// A transform of the JSON report as the text form prints it.
+fn placement(t: &serde_json::Value) -> String {
+    let v = |k: &str| t[k].as_f64().unwrap_or(0.0);
+    format!(
+        "theta {:.3} deg, tx {:.2} px, ty {:.2} px",
+        v("theta").to_degrees(),
+        v("tx"),
+        v("ty")
+    )
+}
+
 fn human(w: &mut impl Write, o: &serde_json::Value) -> std::io::Result<()> {
     let f = |k: &str| o[k].as_f64().unwrap_or(f64::NAN);
     let declined = o["transform"].is_null();
@@ -199,10 +210,8 @@ fn human(w: &mut impl Write, o: &serde_json::Value) -> std::io::Result<()> {
             let (t, v) = (&best["transform"], &best["verification"]);
             writeln!(
                 w,
-                "best placement, declined: theta {:.3} deg, tx {:.2} px, ty {:.2} px; wall lift {:.2} (at 4 px {:.2}), acceptance index {:.3}, overlap {:.1}% of the smaller map, {:.1} % of its compared walls in the other map's free space",
-                t["theta"].as_f64().unwrap_or(0.0).to_degrees(),
-                t["tx"].as_f64().unwrap_or(0.0),
-                t["ty"].as_f64().unwrap_or(0.0),
+                "best placement, declined: {}; wall lift {:.2} (at 4 px {:.2}), acceptance index {:.3}, overlap {:.1}% of the smaller map, {:.1} % of its compared walls in the other map's free space",
+                placement(t),
                 v["wall_lift"].as_f64().unwrap_or(0.0),
                 v["wide_wall_lift"].as_f64().unwrap_or(0.0),
                 v["acceptance_index"].as_f64().unwrap_or(0.0),
@@ -211,15 +220,8 @@ fn human(w: &mut impl Write, o: &serde_json::Value) -> std::io::Result<()> {
             )?;
         }
     } else {
-        let t = &o["transform"];
         let wd = &o["world"];
-        writeln!(
-            w,
-            "B -> A (pixels): theta {:.3} deg, tx {:.2} px, ty {:.2} px",
-            t["theta"].as_f64().unwrap_or(0.0).to_degrees(),
-            t["tx"].as_f64().unwrap_or(0.0),
-            t["ty"].as_f64().unwrap_or(0.0)
-        )?;
+        writeln!(w, "B -> A (pixels): {}", placement(&o["transform"]))?;
         writeln!(
             w,
             "B's map frame in A's (world): x {:.3} m, y {:.3} m, yaw {:.3} deg",
@@ -257,10 +259,8 @@ fn human(w: &mut impl Write, o: &serde_json::Value) -> std::io::Result<()> {
         };
         writeln!(
             w,
-            "runner-up: theta {:.3} deg, tx {:.2} px, ty {:.2} px, {:.0} px from {from} (mean over B's walls); wall lift {:.2} (at 4 px {:.2}), score {:.2} of {of}, {}",
-            t["theta"].as_f64().unwrap_or(0.0).to_degrees(),
-            t["tx"].as_f64().unwrap_or(0.0),
-            t["ty"].as_f64().unwrap_or(0.0),
+            "runner-up: {}, {:.0} px from {from} (mean over B's walls); wall lift {:.2} (at 4 px {:.2}), score {:.2} of {of}, {}",
+            placement(t),
             u["apart_px"].as_f64().unwrap_or(0.0),
             uv["wall_lift"].as_f64().unwrap_or(0.0),
             uv["wide_wall_lift"].as_f64().unwrap_or(0.0),
