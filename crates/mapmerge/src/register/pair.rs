@@ -565,25 +565,14 @@ impl<'m> PairRun<'m> {
     /// The best-ranked candidate that may succeed the declined best (see
     /// [`crate::verify::CleanSuccessor`]), refined if it was not; its index.
     fn successor(&self, candidates: &mut [Candidate]) -> Option<usize> {
-        let verify = &self.config.verify;
-        let rule = verify.clean_successor.as_ref()?;
         let best = candidates.first().filter(|b| b.accepted)?.clone();
-        let succeeds = |c: &Candidate| {
-            let v = &c.verification;
-            c.accepted
-                && rule.fits_cleanly(v)
-                && v.score() >= verify.max_ambiguity * best.verification.score()
-                && best.verification.wall_contradiction
-                    > v.wall_contradiction + contradiction_excess(v, verify)
-                && self.apart(&c.transform, &best.transform) > verify.distinct_px
-        };
         for (i, c) in candidates.iter_mut().enumerate().skip(1) {
-            if !succeeds(c) {
+            if !self.succeeds(c, &best) {
                 continue;
             }
             if !c.refined {
                 self.settle(c);
-                if !succeeds(c) {
+                if !self.succeeds(c, &best) {
                     continue;
                 }
             }
@@ -592,11 +581,35 @@ impl<'m> PairRun<'m> {
         None
     }
 
+    /// Whether `c` may succeed the declined `best` as it stands (see
+    /// [`crate::verify::CleanSuccessor`]); never without the rule.
+    fn succeeds(&self, c: &Candidate, best: &Candidate) -> bool {
+        let verify = &self.config.verify;
+        let Some(rule) = &verify.clean_successor else {
+            return false;
+        };
+        let v = &c.verification;
+        c.accepted
+            && rule.fits_cleanly(v)
+            && v.score() >= verify.max_ambiguity * best.verification.score()
+            && best.verification.wall_contradiction
+                > v.wall_contradiction + contradiction_excess(v, verify)
+            && self.apart(&c.transform, &best.transform) > verify.distinct_px
+    }
+
     /// The declined best succeeded by a clean placement, if one may succeed it (see
     /// [`crate::verify::CleanSuccessor`]): it is put first, its pose settled by the answer's
     /// stages, and it must pass the answer's bars. Whether it did; if not, `candidates` are
     /// left as they were.
     fn succeed(&self, candidates: &mut Vec<Candidate>, timings: &mut Timings) -> bool {
+        // Only a candidate that may succeed before it is settled is settled (`successor`), so
+        // where none may, nothing changes and nothing need be kept to restore.
+        let Some(best) = candidates.first().filter(|b| b.accepted) else {
+            return false;
+        };
+        if !candidates[1..].iter().any(|c| self.succeeds(c, best)) {
+            return false;
+        }
         let before = candidates.clone();
         let Some(i) = self.successor(candidates) else {
             *candidates = before;
