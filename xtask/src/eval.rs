@@ -208,6 +208,11 @@ pub struct EvalArgs {
     /// `0` screens none; default: the library's), for calibration experiments.
     #[arg(long)]
     sweep_screen: Option<usize>,
+    /// Override how deep the deep screen reaches down each sweep's normalised ranking when
+    /// nothing passed (`mapmerge::global::SweepConfig::deep_screened`; `0` turns it off;
+    /// default: the library's), to measure what it changes.
+    #[arg(long)]
+    sweep_deep: Option<usize>,
     /// Override the rotation sweep's coarse image size (default: the library's), for
     /// calibration experiments.
     #[arg(long)]
@@ -1147,6 +1152,7 @@ fn register_config(args: &EvalArgs) -> RegisterConfig {
         set(&mut sweep.translation_peaks, args.sweep_peaks);
         set(&mut sweep.peak_radius, args.sweep_peak_radius);
         set(&mut sweep.screened, args.sweep_screen);
+        set(&mut sweep.deep_screened, args.sweep_deep);
         set(&mut sweep.coarse_size, args.sweep_size);
         set(&mut sweep.max_cell_px, args.sweep_max_cell);
         set(&mut sweep.confident_wall_lift, args.confident_lift);

@@ -130,8 +130,12 @@ fn bench(c: &mut Criterion) {
     let turn = pair_config
         .turn_search
         .expect("the default searches whole-map placements over rotation");
-    // As many of the normalised ranking's placements as `register_with` asks for (to screen).
-    let normalized = sweep.screened.max(sweep.keep_normalized);
+    // As many of the normalised ranking's placements as `register_with` asks for (to screen,
+    // and deeper down when nothing passed).
+    let normalized = sweep
+        .screened
+        .max(sweep.keep_normalized)
+        .max(sweep.deep_screened);
     // A placement as the sweep proposes it: where the local search, ICP and verification
     // start for every whole-map candidate.
     let start = sweep_placements(&ppa, &ppb, &sweep, normalized).plain[0];

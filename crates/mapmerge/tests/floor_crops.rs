@@ -284,6 +284,42 @@ fn a_real_robots_partial_map_cut_in_two_with_nothing_shared_is_declined_as_a_sli
     assert!(disp > 100.0, "{disp} px off");
 }
 
+/// Case 9005018 of `cargo xtask eval --suites sensor --seed 9`: the README's second real map
+/// cut in two with nothing shared. No placement the sweeps screen passes; deeper down their
+/// rankings (`SweepConfig::deep_screened`) one lays the parts 26 px from where they lie, on
+/// 17 % of the smaller part, its walls fitting at wide lift 0.99, which the small-overlap bar
+/// lets pass. An answer found after the deep screen ran must share no less than a small
+/// overlap (`SmallOverlap::below`, 25 %): declined as a sliver.
+#[test]
+fn a_real_robots_map_cut_in_two_with_nothing_shared_is_not_answered_by_a_deep_sliver() {
+    let (pair, reason) = nothing_shared("sunil_pair_b", 9_005_018);
+    assert!(
+        reason.starts_with("sliver: nothing passed until the deep screen, and the placement it found shares 17 % of the smaller map's known cells; found that deep, a placement must share 25 %"),
+        "{reason}"
+    );
+    // Without small overlaps the deep screen proposes the sliver, and it is the answer.
+    let mut without = RegisterConfig::default();
+    without.pair.verify.small_overlap = None;
+    let r = register(&pair.a, &pair.b, &without).unwrap();
+    let c = r.accepted.expect("answered without small overlaps");
+    assert_eq!(c.origin, mapmerge::Origin::Sweep);
+    assert!(
+        c.verification.overlap_fraction < 0.25,
+        "{:?}",
+        c.verification
+    );
+    let disp = displacement_error(&pair.b, &c.transform, &pair.truth).unwrap();
+    assert!(disp > 20.0, "{disp} px off");
+    // And without the deep screen, nothing passes.
+    without.pair.sweep.as_mut().unwrap().deep_screened = 0;
+    assert!(
+        register(&pair.a, &pair.b, &without)
+            .unwrap()
+            .accepted
+            .is_none()
+    );
+}
+
 /// Case 8005012 of `cargo xtask eval --suites sensor --seed 8`: the README's second real map
 /// cut in two with nothing shared, one part little more than a few laser streaks (about 1 000
 /// free cells). Laid inside the other part, it fits at wall lift 0.73 on 86 % of itself, but

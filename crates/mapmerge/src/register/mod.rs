@@ -181,7 +181,8 @@ pub struct Timings {
     /// Global search, when it ran.
     pub global_ms: f64,
     /// Rotation sweep, when it ran (both ways round when the first found nothing that passes,
-    /// see `SweepConfig::reverse`).
+    /// see `SweepConfig::reverse`, and the deep screen when still nothing passed, see
+    /// `SweepConfig::deep_screened`).
     pub sweep_ms: f64,
     /// Symmetry probes of the best accepted candidate, when they ran.
     pub symmetry_ms: f64,
@@ -522,6 +523,40 @@ fn screen(
             searched: Some(scored[i]),
         })
         .collect()
+}
+
+/// The `keep` of `placements` that pass verification once searched (as [`screen`] searches
+/// them), those the maps agree with most ([`Verification::score`]) first; none that fails.
+/// Unlike the screen's, these placements are proposed only when nothing else passed, so one
+/// that fails would only be declined again.
+fn deep_screen(
+    a: &PreparedMap,
+    b: &PreparedMap,
+    placements: Vec<Rigid2>,
+    keep: usize,
+    config: &PairConfig,
+) -> Vec<Placement> {
+    let mut passing: Vec<Placement> = placements
+        .par_iter()
+        .filter_map(|p| {
+            let moved = config
+                .search
+                .as_ref()
+                .map_or(*p, |sc| local_search(a, b, p, sc));
+            let v = verify(a, b, &moved, &config.verify);
+            v.accepted(&config.verify).then_some(Placement {
+                pose: *p,
+                searched: Some((moved, v)),
+            })
+        })
+        .collect();
+    // Stable: ties keep the rankings' order.
+    passing.sort_by(|x, y| {
+        let score = |p: &Placement| p.searched.map_or(0.0, |(_, v)| v.score());
+        score(y).total_cmp(&score(x))
+    });
+    passing.truncate(keep);
+    passing
 }
 
 /// The order in which the screen keeps placements verified as `verifications`: those that pass

@@ -4,6 +4,7 @@
 //! the turn scan, the ascent) and the rules that decline it.
 
 use std::sync::OnceLock;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use rayon::prelude::*;
@@ -13,12 +14,15 @@ use ransac_rigid::estimate_rigid;
 
 use super::{
     APART_POINTS, Candidate, KindTotals, Origin, PairConfig, Placement, Registration, Timings,
-    at_angle, contradiction_excess, fits_about_as_well, manhattan_rotation_near, mean_apart, ms,
-    one_basin, refine_and_score, rivals, screen, short_of, standing_out, stands_out,
-    unverified_reason, wall_centres,
+    at_angle, contradiction_excess, deep_screen, fits_about_as_well, manhattan_rotation_near,
+    mean_apart, ms, one_basin, refine_and_score, rivals, screen, short_of, standing_out,
+    stands_out, unverified_reason, wall_centres,
 };
 use crate::ascent::{ascend, frontier_ratio, lone_wall_share, wall_thickness};
-use crate::global::{global_hypotheses, spectrum_rotation_near, sweep_placements, twins};
+use crate::global::{
+    SweepConfig, SweepPlacements, global_hypotheses, spectrum_rotation_near, sweep_placements,
+    twins,
+};
 use crate::refine::{RefineConfig, refine_with_bias};
 use crate::search::{SearchConfig, local_search};
 use crate::verify::{
@@ -160,6 +164,12 @@ struct PairRun<'m> {
     /// Both maps' shares of lone wall cells (the turn scan's gate and the clean-walls bar),
     /// scanned once, when first needed.
     lone: OnceLock<(f64, f64)>,
+    /// The sweep's placements, B's walls over A's field and the other way round, swept once,
+    /// when first needed, for the screen and for the deep screen.
+    sweeps: [OnceLock<SweepPlacements>; 2],
+    /// Whether the deep screen ran (nothing passed before it): the answer must then share
+    /// no less than a small overlap (see [`Self::declined_answer`]).
+    deep_screened: AtomicBool,
 }
 
 impl<'m> PairRun<'m> {
@@ -171,6 +181,8 @@ impl<'m> PairRun<'m> {
             config,
             probe,
             lone: OnceLock::new(),
+            sweeps: [OnceLock::new(), OnceLock::new()],
+            deep_screened: AtomicBool::new(false),
         }
     }
 
@@ -367,45 +379,83 @@ impl<'m> PairRun<'m> {
         c.accepted && c.origin == Origin::Ransac && c.verification.wall_lift >= bar
     }
 
+    /// The sweep's placements as swept, B's walls turned over A's field or, with `reverse`, A's
+    /// over B's: the normalised ranking as deep as the deep screen reaches, so that one sweep
+    /// serves both screens (the first placements of a ranking do not depend on how many are
+    /// taken).
+    fn sweep(&self, sweep: &SweepConfig, reverse: bool) -> &SweepPlacements {
+        self.sweeps[usize::from(reverse)].get_or_init(|| {
+            let (field, moving) = if reverse {
+                (&self.pb, &self.pa)
+            } else {
+                (&self.pa, &self.pb)
+            };
+            let count = sweep
+                .screened
+                .max(sweep.keep_normalized)
+                .max(sweep.deep_screened);
+            sweep_placements(field, moving, sweep, count)
+        })
+    }
+
+    /// `placements` of the sweep with `reverse`, as maps of B onto A.
+    fn onto_a(placements: &[Rigid2], reverse: bool) -> Vec<Rigid2> {
+        if reverse {
+            placements
+                .iter()
+                .map(|t| t.inverse().normalized())
+                .collect()
+        } else {
+            placements.to_vec()
+        }
+    }
+
     /// The sweep's placements, as maps of B onto A: B's walls turned over A's field, or with
     /// `reverse` A's over B's, the placements then inverted.
     fn swept(&self, reverse: bool) -> Vec<Placement> {
         let Some(sweep) = &self.config.sweep else {
             return Vec::new();
         };
-        let (field, moving) = if reverse {
-            (&self.pb, &self.pa)
-        } else {
-            (&self.pa, &self.pb)
-        };
-        let found = sweep_placements(
-            field,
-            moving,
-            sweep,
-            sweep.screened.max(sweep.keep_normalized),
-        );
-        let onto_a = |placements: Vec<Rigid2>| -> Vec<Rigid2> {
-            if reverse {
-                placements
-                    .into_iter()
-                    .map(|t| t.inverse().normalized())
-                    .collect()
-            } else {
-                placements
-            }
-        };
-        let mut out: Vec<Placement> = onto_a(found.plain)
+        let found = self.sweep(sweep, reverse);
+        let screened = sweep.screened.max(sweep.keep_normalized);
+        let normalized = &found.normalized[..found.normalized.len().min(screened)];
+        let mut out: Vec<Placement> = Self::onto_a(&found.plain, reverse)
             .into_iter()
             .map(Placement::unsearched)
             .collect();
         out.extend(screen(
             &self.pa,
             &self.pb,
-            onto_a(found.normalized),
+            Self::onto_a(normalized, reverse),
             sweep.keep_normalized,
             self.config,
         ));
         out
+    }
+
+    /// The deep screen (see [`SweepConfig::deep_screened`]): the placements of both sweeps'
+    /// normalised rankings after the screened ones, searched and verified, and of those that
+    /// pass the `keep_normalized` the maps agree with most.
+    fn deep_swept(&self) -> Vec<Placement> {
+        let Some(sweep) = &self.config.sweep else {
+            return Vec::new();
+        };
+        let screened = sweep.screened.max(sweep.keep_normalized);
+        let deeper: Vec<Rigid2> = [false, true]
+            .into_iter()
+            .flat_map(|reverse| {
+                let normalized = &self.sweep(sweep, reverse).normalized;
+                let end = normalized.len().min(sweep.deep_screened);
+                Self::onto_a(normalized.get(screened..end).unwrap_or(&[]), reverse)
+            })
+            .collect();
+        deep_screen(
+            &self.pa,
+            &self.pb,
+            deeper,
+            sweep.keep_normalized,
+            self.config,
+        )
     }
 
     /// The whole-map searches, their candidates added to `candidates`: the global search
@@ -447,6 +497,17 @@ impl<'m> PairRun<'m> {
                     || self.declined_answer(candidates).is_some()
             } {
                 let (found, t) = self.search(&|out| out.extend(self.swept(true)), Origin::Sweep);
+                candidates.extend(found);
+                timings.sweep_ms += t;
+            }
+            // Still nothing passed: deeper down both rankings (see
+            // `SweepConfig::deep_screened`).
+            if sweep.deep_screened > sweep.screened.max(sweep.keep_normalized) && {
+                self.rank(candidates);
+                !candidates.first().is_some_and(|c| c.accepted)
+            } {
+                self.deep_screened.store(true, Ordering::Relaxed);
+                let (found, t) = self.search(&|out| out.extend(self.deep_swept()), Origin::Sweep);
                 candidates.extend(found);
                 timings.sweep_ms += t;
             }
@@ -893,6 +954,19 @@ impl<'m> PairRun<'m> {
                 100.0 * small.below,
                 small.min_wide_wall_lift,
                 short_of(v.wide_wall_lift, small.min_wide_wall_lift)
+            ));
+        }
+        // Found only deep down the sweeps' rankings, where thousands of placements were tried,
+        // a sliver is what chance gives, however well its walls fit (see
+        // `SweepConfig::deep_screened`).
+        if let Some(small) = &config.verify.small_overlap
+            && self.deep_screened.load(Ordering::Relaxed)
+            && v.overlap_fraction < small.below
+        {
+            return Some(format!(
+                "sliver: nothing passed until the deep screen, and the placement it found shares {:.0} % of the smaller map's known cells; found that deep, a placement must share {:.0} %",
+                100.0 * v.overlap_fraction,
+                100.0 * small.below
             ));
         }
         if v.too_small(&config.verify) {

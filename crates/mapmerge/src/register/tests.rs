@@ -139,6 +139,53 @@ fn the_screen_keeps_the_placements_that_fit_once_searched() {
 }
 
 #[test]
+fn the_deep_screen_keeps_only_the_placements_that_pass_once_searched() {
+    // The screen's test's room and placements: the truth moved 5 px, a half turn and shifts
+    // (the room's half turn fits it too).
+    let a = room();
+    let truth = Rigid2::new(0.0, -7.0, 4.0);
+    let b = a.warp(&truth.inverse(), 120, 100).unwrap();
+    let vc = VerifyConfig::default();
+    let (pa, pb) = (PreparedMap::new(&a, &vc), PreparedMap::new(&b, &vc));
+    let placements = vec![
+        Rigid2::new(std::f64::consts::PI, 120.0, 100.0),
+        Rigid2::new(0.0, 40.0, 0.0),
+        Rigid2::new(0.0, -2.0, 4.0),
+        Rigid2::new(0.0, -7.0, 45.0),
+    ];
+    let config = PairConfig::default();
+    let searched: Vec<Placement> = placements
+        .iter()
+        .map(|p| {
+            let moved = local_search(&pa, &pb, p, config.search.as_ref().unwrap());
+            Placement {
+                pose: *p,
+                searched: Some((moved, verify(&pa, &pb, &moved, &config.verify))),
+            }
+        })
+        .collect();
+    let passes = |p: &Placement| p.searched.unwrap().1.accepted(&config.verify);
+    let score = |p: &Placement| p.searched.unwrap().1.score();
+    // Some pass and some do not, so that the test tells.
+    assert_eq!(searched.iter().filter(|p| passes(p)).count(), 3);
+    // Those that pass, with where they were searched to, the best score first.
+    let mut expected: Vec<Placement> = searched.iter().copied().filter(passes).collect();
+    expected.sort_by(|x, y| score(y).total_cmp(&score(x)));
+    assert_eq!(expected[0].pose, placements[2]);
+    assert_eq!(
+        deep_screen(&pa, &pb, placements.clone(), 4, &config),
+        expected
+    );
+    assert_eq!(
+        deep_screen(&pa, &pb, placements.clone(), 1, &config),
+        expected[..1]
+    );
+    // None that passes: none kept.
+    let failing = vec![placements[1]];
+    assert!(deep_screen(&pa, &pb, failing, 4, &config).is_empty());
+}
+
+#[test]
 fn the_screen_keeps_passing_placements_first() {
     let config = VerifyConfig::default();
     let scored = |lift: f64, support: usize, overlap: f64| Verification {
