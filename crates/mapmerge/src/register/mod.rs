@@ -506,13 +506,7 @@ fn screen(
     }
     let scored: Vec<(Rigid2, Verification)> = placements
         .par_iter()
-        .map(|p| {
-            let moved = config
-                .search
-                .as_ref()
-                .map_or(*p, |sc| local_search(a, b, p, sc));
-            (moved, verify(a, b, &moved, &config.verify))
-        })
+        .map(|p| searched(a, b, p, config))
         .collect();
     let verifications: Vec<Verification> = scored.iter().map(|s| s.1).collect();
     screen_order(&verifications, &config.verify)
@@ -523,6 +517,21 @@ fn screen(
             searched: Some(scored[i]),
         })
         .collect()
+}
+
+/// Where the correlative local search (`config.search`, if any) moves `placement`, and how
+/// that pose verifies: what both screens look at.
+fn searched(
+    a: &PreparedMap,
+    b: &PreparedMap,
+    placement: &Rigid2,
+    config: &PairConfig,
+) -> (Rigid2, Verification) {
+    let moved = config
+        .search
+        .as_ref()
+        .map_or(*placement, |sc| local_search(a, b, placement, sc));
+    (moved, verify(a, b, &moved, &config.verify))
 }
 
 /// The `keep` of `placements` that pass verification once searched (as [`screen`] searches
@@ -539,11 +548,7 @@ fn deep_screen(
     let mut passing: Vec<Placement> = placements
         .par_iter()
         .filter_map(|p| {
-            let moved = config
-                .search
-                .as_ref()
-                .map_or(*p, |sc| local_search(a, b, p, sc));
-            let v = verify(a, b, &moved, &config.verify);
+            let (moved, v) = searched(a, b, p, config);
             v.accepted(&config.verify).then_some(Placement {
                 pose: *p,
                 searched: Some((moved, v)),

@@ -106,23 +106,29 @@ fn a_room_that_looks_the_same_turned_is_declined_as_ambiguous() {
     );
 }
 
-#[test]
-fn the_screen_keeps_the_placements_that_fit_once_searched() {
-    // B is the room moved by (7, -4) px; the placements are the truth moved 5 px (within
-    // the local search's reach), and wrong ones: a half turn, and far shifts.
+/// The screens' case: A, B (the room moved by (7, -4) px) and placements of B onto A, the
+/// third the truth moved 5 px (within the local search's reach), the others wrong: a half
+/// turn, and far shifts.
+fn screen_case() -> (OccupancyGrid, OccupancyGrid, Vec<Rigid2>) {
     let a = room();
     let truth = Rigid2::new(0.0, -7.0, 4.0);
     let b = a.warp(&truth.inverse(), 120, 100).unwrap();
-    let vc = VerifyConfig::default();
-    let (pa, pb) = (PreparedMap::new(&a, &vc), PreparedMap::new(&b, &vc));
-    let near = Rigid2::new(0.0, -2.0, 4.0);
-    let wrong = [
+    let placements = vec![
         Rigid2::new(std::f64::consts::PI, 120.0, 100.0),
         Rigid2::new(0.0, 40.0, 0.0),
+        Rigid2::new(0.0, -2.0, 4.0),
         Rigid2::new(0.0, -7.0, 45.0),
     ];
+    (a, b, placements)
+}
+
+#[test]
+fn the_screen_keeps_the_placements_that_fit_once_searched() {
+    let (a, b, placements) = screen_case();
+    let vc = VerifyConfig::default();
+    let (pa, pb) = (PreparedMap::new(&a, &vc), PreparedMap::new(&b, &vc));
+    let near = placements[2];
     let config = PairConfig::default();
-    let placements = vec![wrong[0], wrong[1], near, wrong[2]];
     let poses = |kept: &[Placement]| kept.iter().map(|p| p.pose).collect::<Vec<_>>();
     let one = screen(&pa, &pb, placements.clone(), 1, &config);
     assert_eq!(poses(&one), vec![near]);
@@ -140,19 +146,10 @@ fn the_screen_keeps_the_placements_that_fit_once_searched() {
 
 #[test]
 fn the_deep_screen_keeps_only_the_placements_that_pass_once_searched() {
-    // The screen's test's room and placements: the truth moved 5 px, a half turn and shifts
-    // (the room's half turn fits it too).
-    let a = room();
-    let truth = Rigid2::new(0.0, -7.0, 4.0);
-    let b = a.warp(&truth.inverse(), 120, 100).unwrap();
+    // The room's half turn fits it too.
+    let (a, b, placements) = screen_case();
     let vc = VerifyConfig::default();
     let (pa, pb) = (PreparedMap::new(&a, &vc), PreparedMap::new(&b, &vc));
-    let placements = vec![
-        Rigid2::new(std::f64::consts::PI, 120.0, 100.0),
-        Rigid2::new(0.0, 40.0, 0.0),
-        Rigid2::new(0.0, -2.0, 4.0),
-        Rigid2::new(0.0, -7.0, 45.0),
-    ];
     let config = PairConfig::default();
     let searched: Vec<Placement> = placements
         .iter()
