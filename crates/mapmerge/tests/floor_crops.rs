@@ -292,13 +292,23 @@ fn a_real_robots_partial_map_cut_in_two_with_nothing_shared_is_declined_as_a_sli
 /// overlap (`SmallOverlap::below`, 25 %): declined as a sliver.
 #[test]
 fn a_real_robots_map_cut_in_two_with_nothing_shared_is_not_answered_by_a_deep_sliver() {
-    let (pair, reason) = nothing_shared("sunil_pair_b", 9_005_018);
+    let config = mapsim::CropConfig {
+        overlap: 0.0,
+        ..Default::default()
+    };
+    let pair = mapsim::crop_pair(&floor("sunil_pair_b"), &config, 9_005_018).unwrap();
+    // The deep screen is off by default.
+    let mut deep = RegisterConfig::default();
+    deep.pair.sweep.as_mut().unwrap().deep_screened = 1000;
+    let r = register(&pair.a, &pair.b, &deep).unwrap();
+    assert!(r.accepted.is_none());
+    let reason = r.reason.unwrap_or_default();
     assert!(
         reason.starts_with("sliver: nothing passed until the deep screen, and the placement it found shares 17 % of the smaller map's known cells; found that deep, a placement must share 25 %"),
         "{reason}"
     );
     // Without small overlaps the deep screen proposes the sliver, and it is the answer.
-    let mut without = RegisterConfig::default();
+    let mut without = deep;
     without.pair.verify.small_overlap = None;
     let r = register(&pair.a, &pair.b, &without).unwrap();
     let c = r.accepted.expect("answered without small overlaps");
