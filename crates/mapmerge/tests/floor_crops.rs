@@ -54,13 +54,22 @@ fn crops(name: &str, degrees: f64, keep_percent: u64) -> (OccupancyGrid, Occupan
 /// `seed` of `cargo xtask eval --suites crops`' zero-overlap rows), and the registration's
 /// reason for declining it with the default settings (empty if it was answered).
 fn nothing_shared(name: &str, seed: u64) -> (mapsim::CropPair, String) {
+    nothing_shared_with(name, seed, &RegisterConfig::default())
+}
+
+/// [`nothing_shared`], registered with `settings` rather than the defaults.
+fn nothing_shared_with(
+    name: &str,
+    seed: u64,
+    settings: &RegisterConfig,
+) -> (mapsim::CropPair, String) {
     let config = mapsim::CropConfig {
         overlap: 0.0,
         ..Default::default()
     };
     let pair = mapsim::crop_pair(&floor(name), &config, seed).unwrap();
     assert_eq!(pair.overlap, 0.0);
-    let r = register(&pair.a, &pair.b, &RegisterConfig::default()).unwrap();
+    let r = register(&pair.a, &pair.b, settings).unwrap();
     let reason = if r.accepted.is_none() {
         r.reason.unwrap_or_default()
     } else {
@@ -292,17 +301,10 @@ fn a_real_robots_partial_map_cut_in_two_with_nothing_shared_is_declined_as_a_sli
 /// overlap (`SmallOverlap::below`, 25 %): declined as a sliver.
 #[test]
 fn a_real_robots_map_cut_in_two_with_nothing_shared_is_not_answered_by_a_deep_sliver() {
-    let config = mapsim::CropConfig {
-        overlap: 0.0,
-        ..Default::default()
-    };
-    let pair = mapsim::crop_pair(&floor("sunil_pair_b"), &config, 9_005_018).unwrap();
     // The deep screen is off by default.
     let mut deep = RegisterConfig::default();
     deep.pair.sweep.as_mut().unwrap().deep_screened = 1000;
-    let r = register(&pair.a, &pair.b, &deep).unwrap();
-    assert!(r.accepted.is_none());
-    let reason = r.reason.unwrap_or_default();
+    let (pair, reason) = nothing_shared_with("sunil_pair_b", 9_005_018, &deep);
     assert!(
         reason.starts_with("sliver: nothing passed until the deep screen, and the placement it found shares 17 % of the smaller map's known cells; found that deep, a placement must share 25 %"),
         "{reason}"
