@@ -1032,14 +1032,16 @@ pub struct SweepConfig {
     ///
     /// On a large floor the placement near the truth can rank far down: in the four pairs of
     /// the uos_cic floor at 30 % overlap declined at seed 7 (`cargo xtask eval --suites floors
-    /// --only "uos_cic world, overlap 0.3" --seed 7`) it ranked 148th-615th, the truth fitting
-    /// at wall lift 0.65-0.80 once refined, anything screened at 0.40-0.47. Over the
+    /// --only "uos_cic world, overlap 0.3" --seed 7`) it ranked 149th-616th where it ranked
+    /// at all (`cargo run --release -p mapmerge --example sweep_ranks`), the truth fitting at
+    /// wall lift 0.65-0.80 once refined, anything screened at 0.40-0.47. Over the
     /// regression batch it registered 11 pairs more and lost none, and answered no pair that
     /// shares nothing (docs/EVALUATION.md, "The deep screen, off by default"). Only pairs
     /// where nothing passed pay for it, but they pay much: the declined bench pair (2048 x
     /// 2048) takes about three times as long (694 ms against 227 ms). It stays off because
     /// at five held-out seeds it answered five open-hall pairs of the simulated 30 % rows
-    /// 206-233 px off (declined without it) for two more registered.
+    /// 206-233 px off (declined without it) for two more registered. `mapmerge estimate|merge
+    /// --deep-screen` turns it on at 1000.
     pub deep_screened: usize,
 }
 

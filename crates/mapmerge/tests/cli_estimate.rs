@@ -657,3 +657,26 @@ fn climb_brings_a_short_range_sensors_answer_its_frontiers_miss_to_the_truth() {
         "with --climb: {disp} px, {rot} degrees off"
     );
 }
+
+/// Case 7002009 of `cargo xtask eval --suites floors --only "uos_cic world, overlap 0.3"
+/// --seed 7` (two lidar robots with 10 % range noise on the uos_cic floor), saved as map files:
+/// nothing the default search proposes passes, and the pair is declined (exit 3).
+/// `--deep-screen` searches the sweep's rankings 1,000 deep and registers it within 3 px
+/// (2.41 px in `simulated_pairs::a_large_floor_pair_is_registered_from_deep_down_the_sweeps_ranking`,
+/// which calls the library).
+#[test]
+fn deep_screen_registers_a_large_floor_pair_declined_without_it() {
+    let case = common::floor_case(common::fixture_floor("uos_cic"), 7_002_009);
+    let (b, truth) = (&case.robots[1].map, case.truth(0, 1));
+    let dir = TempDir::new().unwrap();
+    let (a_path, b_path) = (dir.path().join("a.yaml"), dir.path().join("b.yaml"));
+    save_map(&case.robots[0].map, &a_path).unwrap();
+    save_map(b, &b_path).unwrap();
+    let out = estimate_json(&a_path, &b_path, &[]);
+    assert_eq!(out.status.code(), Some(3), "{}", json(&out));
+    let out = estimate_json(&a_path, &b_path, &["--deep-screen"]);
+    let v = json(&out);
+    assert_eq!(out.status.code(), Some(0), "{v}");
+    let error = displacement_error(b, &transform(&v), &truth).unwrap();
+    assert!(error < 3.0, "{error} px off");
+}

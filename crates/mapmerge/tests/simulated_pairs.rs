@@ -11,6 +11,9 @@
 //! counting mapper, and a clean answer's rival that puts walls in free space
 //! (`VerifyConfig::clean_contradiction_excess`).
 
+mod common;
+
+use common::{fixture_floor, floor_case};
 use grid_core::metrics::displacement_error;
 use grid_core::{DVec2, OccupancyGrid};
 use mapmerge::{Origin, RegisterConfig, Registration, register};
@@ -722,15 +725,6 @@ fn a_warehouse_pair_whose_best_placement_is_a_quarter_turn_off_is_declined() {
     });
 }
 
-/// The floor `name` of `fixtures/maps` (its `name/name.yaml`).
-fn fixture_floor(name: &str) -> OccupancyGrid {
-    let path = format!(
-        "{}/../../fixtures/maps/{name}/{name}.yaml",
-        env!("CARGO_MANIFEST_DIR")
-    );
-    grid_core::io::load_map(path, &Default::default()).unwrap()
-}
-
 /// The nav2 depot of `fixtures/maps`, a warehouse whose shelf rows repeat.
 fn depot() -> OccupancyGrid {
     fixture_floor("nav2_depot")
@@ -775,30 +769,6 @@ fn a_warehouse_pair_matched_by_crisp_walls_a_quarter_turn_off_is_declined() {
     let case = floor_case(depot(), 7_004_003);
     declined_for(&case, "lays walls on walls crisply");
     answered_far_off_without(&case, |verify| verify.crisp_wall_lift = 2.0);
-}
-
-/// Case `seed` of a row of `cargo xtask eval` on a real floor (`--suites real` or `large`):
-/// two lidar robots with 10 % range noise exploring `floor` at 30 % overlap.
-fn floor_case(floor: OccupancyGrid, seed: u64) -> Case {
-    let config = CaseConfig {
-        world: WorldConfig {
-            kind: WorldKind::Grid(floor),
-            width: 0,
-            height: 0,
-            ..WorldConfig::default()
-        },
-        robots: vec![
-            RobotConfig {
-                noise_bound: 0.1,
-                ..RobotConfig::default()
-            };
-            2
-        ],
-        overlap: 0.3,
-        overlap_tolerance: f64::INFINITY,
-        ..CaseConfig::default()
-    };
-    generate_case(&config, seed).unwrap()
 }
 
 /// Case 7000001 of `cargo xtask eval --suites large --seed 7`: two robots in the nav2

@@ -1,16 +1,46 @@
-//! Helpers of the tests that run the `mapmerge` binary (`cli_*.rs`): each test file uses some
-//! of them.
+//! Helpers of the tests that run the `mapmerge` binary (`cli_*.rs`), and the simulated pairs
+//! on real floors that those and `simulated_pairs.rs` share: each test file uses some of them.
 #![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use grid_core::Rigid2;
+use grid_core::{OccupancyGrid, Rigid2};
+use mapsim::{Case, CaseConfig, RobotConfig, WorldConfig, WorldKind, generate_case};
 
 /// `fixtures/maps/NAME/NAME.yaml`.
 pub fn fixture(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join(format!("../../fixtures/maps/{name}/{name}.yaml"))
+}
+
+/// The floor `name` of `fixtures/maps` (its `name/name.yaml`), loaded.
+pub fn fixture_floor(name: &str) -> OccupancyGrid {
+    grid_core::io::load_map(fixture(name), &Default::default()).unwrap()
+}
+
+/// Case `seed` of a row of `cargo xtask eval` on a real floor (`--suites real`, `floors` or
+/// `large`): two lidar robots with 10 % range noise exploring `floor` at 30 % overlap.
+pub fn floor_case(floor: OccupancyGrid, seed: u64) -> Case {
+    let config = CaseConfig {
+        world: WorldConfig {
+            kind: WorldKind::Grid(floor),
+            width: 0,
+            height: 0,
+            ..WorldConfig::default()
+        },
+        robots: vec![
+            RobotConfig {
+                noise_bound: 0.1,
+                ..RobotConfig::default()
+            };
+            2
+        ],
+        overlap: 0.3,
+        overlap_tolerance: f64::INFINITY,
+        ..CaseConfig::default()
+    };
+    generate_case(&config, seed).unwrap()
 }
 
 /// Run `mapmerge args`.
