@@ -196,6 +196,10 @@ fn a_declined_pair_shows_the_placement_it_declined_and_the_runner_up() {
             100.0 * f(&bv["wall_contradiction"])
         )
     );
+    // No placement passed, so both forms point to `--deep-screen`.
+    let hint = v["hint"].as_str().unwrap_or_else(|| panic!("no hint: {v}"));
+    assert!(hint.contains("--deep-screen"), "{hint}");
+    assert_eq!(line("hint: "), format!("hint: {hint}"));
     let u = &v["runner_up"];
     let runner_up = line("runner-up: ");
     assert!(
@@ -328,6 +332,8 @@ fn maps_without_enough_walls_are_declined_and_told_so() {
         v["reason"],
         "too few walls: the maps have 33 occupied cells together, fewer than the 40 an answer must compare"
     );
+    // Declined before any placement was checked: no hint to search deeper.
+    assert!(v.get("hint").is_none(), "{v}");
 }
 
 fn s(p: &Path) -> &str {
@@ -584,6 +590,9 @@ fn parts_of_a_clean_floor_that_share_nothing_are_declined_for_their_misfit() {
         reason.starts_with("misfit: both maps draw their walls cleanly (lone wall cells"),
         "{reason}"
     );
+    // A placement passed the verification (and was declined after it): the deep screen would
+    // not run, so no hint points to it.
+    assert!(v.get("hint").is_none(), "{v}");
     let out = common::mapmerge(&["estimate", s(&a), s(&b), "--json", "--no-clean-walls"]);
     let v = json(&out);
     assert_eq!(out.status.code(), Some(0), "{v}");
@@ -673,7 +682,15 @@ fn deep_screen_registers_a_large_floor_pair_declined_without_it() {
     save_map(&case.robots[0].map, &a_path).unwrap();
     save_map(b, &b_path).unwrap();
     let out = estimate_json(&a_path, &b_path, &[]);
-    assert_eq!(out.status.code(), Some(3), "{}", json(&out));
+    let v = json(&out);
+    assert_eq!(out.status.code(), Some(3), "{v}");
+    // Nothing passed, so the decline points to the flag.
+    assert!(
+        v["hint"]
+            .as_str()
+            .is_some_and(|h| h.contains("--deep-screen")),
+        "{v}"
+    );
     let out = estimate_json(&a_path, &b_path, &["--deep-screen"]);
     let v = json(&out);
     assert_eq!(out.status.code(), Some(0), "{v}");

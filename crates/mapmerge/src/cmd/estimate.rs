@@ -43,6 +43,8 @@ Output (--json): one JSON object on stdout.
                    the pair ambiguous, and declined
   best_rejected    of a declined pair: the best-ranked placement, declined (transform,
                    verification); its runner_up is measured from it
+  hint             of a declined pair where no placement passed, without --deep-screen: what
+                   --deep-screen might find (absent otherwise)
   method, hypothesis (ransac, global, sweep or symmetry), correspondences, candidates, timings_ms
 
 Exit codes: 0 transform found, 3 no trustworthy match (the pair is declined), 2 bad usage or
@@ -179,10 +181,26 @@ fn report(
             })),
         }),
     };
+    if let (Some(o), Some(hint)) = (out.as_object_mut(), deep_screen_hint(args, r)) {
+        o.insert("hint".into(), hint.into());
+    }
     if let (Some(o), Some(c)) = (out.as_object_mut(), common.as_object()) {
         o.extend(c.clone());
     }
     out
+}
+
+/// What `--deep-screen` might do for a declined pair: said only where it would run, when
+/// candidates were checked and none passed, and only when it was not given.
+fn deep_screen_hint(args: &EstimateArgs, r: &Registration) -> Option<&'static str> {
+    (!args.registration.deep_screen
+        && !r.candidates.is_empty()
+        && r.candidates.iter().all(|c| !c.accepted))
+    .then_some(
+        "no placement passed. If the maps do share part of a large floor, the placement near \
+         the truth may rank below the 100 the rotation sweep screens: --deep-screen searches \
+         1,000 deep (and may then answer an open hall wrongly; check its answer)",
+    )
 }
 
 /// A transform of the JSON report as the text form prints it.
@@ -218,6 +236,9 @@ fn human(w: &mut impl Write, o: &serde_json::Value) -> std::io::Result<()> {
                 100.0 * v["overlap_fraction"].as_f64().unwrap_or(0.0),
                 100.0 * v["wall_contradiction"].as_f64().unwrap_or(0.0)
             )?;
+        }
+        if let Some(hint) = o["hint"].as_str() {
+            writeln!(w, "hint: {hint}")?;
         }
     } else {
         let wd = &o["world"];
