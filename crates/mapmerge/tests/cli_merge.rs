@@ -610,6 +610,18 @@ fn a_map_that_overlaps_no_other_is_left_out_or_nothing_is_written() {
             &unlinked
         ]
     );
+    // The pairs of the floor with the house: declined with no placement passing, each with
+    // the hint that names the deeper search; the floor's own pair, accepted, without it.
+    let pairs = report["pairs"].as_array().unwrap();
+    let hinted: Vec<bool> = pairs
+        .iter()
+        .map(|p| {
+            p["hint"]
+                .as_str()
+                .is_some_and(|h| h.contains("--deep-screen"))
+        })
+        .collect();
+    assert_eq!(hinted, [true, true, false], "{report}");
     let left: Vec<_> = std::fs::read_dir(dir.path())
         .unwrap()
         .map(|e| e.unwrap().file_name().into_string().unwrap())

@@ -11,7 +11,8 @@ use mapmerge::{Registration, RunnerUp, register};
 use serde_json::json;
 
 use super::{
-    BareImageArgs, RegistrationArgs, UsageError, load, refuse_overwriting, require_directory,
+    BareImageArgs, RegistrationArgs, UsageError, deep_screen_hint, load, refuse_overwriting,
+    require_directory,
 };
 
 const AFTER: &str = "\
@@ -181,26 +182,13 @@ fn report(
             })),
         }),
     };
-    if let (Some(o), Some(hint)) = (out.as_object_mut(), deep_screen_hint(args, r)) {
+    if let (Some(o), Some(hint)) = (out.as_object_mut(), deep_screen_hint(&args.registration, r)) {
         o.insert("hint".into(), hint.into());
     }
     if let (Some(o), Some(c)) = (out.as_object_mut(), common.as_object()) {
         o.extend(c.clone());
     }
     out
-}
-
-/// What `--deep-screen` might do for a declined pair: said only where it would run, when
-/// candidates were checked and none passed, and only when it was not given.
-fn deep_screen_hint(args: &EstimateArgs, r: &Registration) -> Option<&'static str> {
-    (!args.registration.deep_screen
-        && !r.candidates.is_empty()
-        && r.candidates.iter().all(|c| !c.accepted))
-    .then_some(
-        "no placement passed. If the maps do share part of a large floor, the placement near \
-         the truth may rank below the 100 the rotation sweep screens: --deep-screen searches \
-         1,000 deep (and may then answer an open hall wrongly; check its answer)",
-    )
 }
 
 /// A transform of the JSON report as the text form prints it.

@@ -16,7 +16,8 @@ use mapmerge::team::{TeamConfig, TeamPair, merge_team};
 use serde_json::{Value, json};
 
 use super::{
-    BareImageArgs, RegistrationArgs, UsageError, load, refuse_overwriting, require_directory,
+    BareImageArgs, RegistrationArgs, UsageError, deep_screen_hint, load, refuse_overwriting,
+    require_directory,
 };
 
 const AFTER: &str = "\
@@ -45,7 +46,8 @@ Output:
                       resampled to the merged map's resolution), confidence, status (tree,
                       loop, dropped, weak: accepted below --min-lift, declined, unreached),
                       residual of the final poses against the pair's answer (rotation_deg,
-                      translation_px)
+                      translation_px); reason when declined or weak, and hint when declined
+                      with no placement passing, without --deep-screen
     acceptance_index  agree / (agree + disagree) over every two maps known at the same cell
     overlap_cells, output, timings_ms
 
@@ -261,7 +263,7 @@ pub fn run(args: &MergeArgs, bare: &BareImageArgs) -> anyhow::Result<ExitCode> {
         "method": args.registration.method,
         "seed": args.registration.seed,
         "pairs": merged.pairs.iter().map(|p| {
-            pair_report(&args.maps, p, p.edge.map(|e| (solution.status[e], solution.residuals[e])), args.min_lift)
+            pair_report(&args.maps, p, p.edge.map(|e| (solution.status[e], solution.residuals[e])), args)
         }).collect::<Vec<_>>(),
     });
     // Maps that the pairs link to each other but not to the reference: the user can merge
@@ -614,9 +616,9 @@ fn pair_report(
     paths: &[PathBuf],
     p: &TeamPair,
     edge: Option<(EdgeStatus, fusion::EdgeResidual)>,
-    min_lift: f64,
+    args: &MergeArgs,
 ) -> Value {
-    let r = &p.registration;
+    let (r, min_lift) = (&p.registration, args.min_lift);
     let mut v = json!({
         "a": paths[p.a].display().to_string(),
         "b": paths[p.b].display().to_string(),
@@ -654,6 +656,9 @@ fn pair_report(
                     .clone()
                     .unwrap_or_else(|| "no trustworthy match".into())
             );
+            if let Some(hint) = deep_screen_hint(&args.registration, r) {
+                v["hint"] = json!(hint);
+            }
         }
     }
     v
@@ -761,6 +766,17 @@ fn human(w: &mut impl Write, r: &Value) -> std::io::Result<()> {
                 p["reason"].as_str().unwrap_or("?")
             )?;
         }
+    }
+    // One line for every pair that `--deep-screen` might answer (they share the text).
+    let pairs = r["pairs"].as_array().map(Vec::as_slice).unwrap_or(&[]);
+    let hinted: Vec<&str> = pairs.iter().filter_map(|p| p["hint"].as_str()).collect();
+    if let Some(hint) = hinted.first() {
+        let n = hinted.len();
+        writeln!(
+            w,
+            "hint ({n} declined pair{}): {hint}",
+            if n == 1 { "" } else { "s" }
+        )?;
     }
     if !o.is_null() {
         match r["acceptance_index"].as_f64() {

@@ -16,7 +16,7 @@ use anyhow::Context;
 use clap::Args;
 use grid_core::Pose2;
 use grid_core::io::{BareImageDefaults, LoadOptions, LoadedMap};
-use mapmerge::{Method, RegisterConfig};
+use mapmerge::{Method, RegisterConfig, Registration};
 
 /// Exit code: success.
 pub const EXIT_OK: u8 = 0;
@@ -214,6 +214,17 @@ impl RegistrationArgs {
         }
         config
     }
+}
+
+/// What `--deep-screen` might do for a declined pair, in the report's `hint`: said only where
+/// it would run (placements were checked and none passed) and only when it was not given.
+pub fn deep_screen_hint(args: &RegistrationArgs, r: &Registration) -> Option<&'static str> {
+    (!args.deep_screen && !r.candidates.is_empty() && r.candidates.iter().all(|c| !c.accepted))
+        .then_some(
+            "no placement passed. If the maps do share part of a large floor, the placement \
+             near the truth may rank below the 100 the rotation sweep screens: --deep-screen \
+             searches 1,000 deep (and may then answer an open hall wrongly; check its answer)",
+        )
 }
 
 fn parse_method(s: &str) -> Result<Method, String> {
