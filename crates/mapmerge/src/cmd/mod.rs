@@ -169,8 +169,9 @@ pub struct RegistrationArgs {
     pub climb: bool,
     /// Before declining a pair where nothing passed, search and verify the rotation sweep's
     /// placements 1,000 deep in each direction instead of 100. On a large building floor the
-    /// placement near the truth can rank far down: of 20 simulated pairs on the uos_cic floor
-    /// at 30 % overlap (seed 7) it registers 17 instead of 12. Off by default because in
+    /// placement near the truth can rank far down: of 40 simulated pairs on the uos_cic floor
+    /// at 30 % overlap (seeds 7 and 8) it registers 31 instead of 28, and declines none
+    /// instead of 6 (the other 3 it answers 3.5-6 px off). Off by default because in
     /// open halls, where two maps share mostly free space, it can find a confident wrong
     /// answer (5 of 400 held-out simulated indoor pairs answered about 200 px off), and a
     /// declined pair takes about three times as long
