@@ -85,6 +85,17 @@ fn bench(c: &mut Criterion) {
     g.bench_function("end_to_end_partial_maps_declined", |bn| {
         bn.iter(|| register(&za, &zb, &config).expect("valid config"))
     });
+    // The same pair with the deep screen on (`mapmerge --deep-screen`): what a declined pair
+    // pays for it, since only pairs where nothing passed run it.
+    let mut deep = config.clone();
+    if let Some(sweep) = deep.pair.sweep.as_mut() {
+        sweep.deep_screened = 1000;
+    }
+    let answer = register(&za, &zb, &deep).expect("valid config");
+    assert!(answer.accepted.is_none(), "accepted {:?}", answer.accepted);
+    g.bench_function("end_to_end_partial_maps_declined_deep_screen", |bn| {
+        bn.iter(|| register(&za, &zb, &deep).expect("valid config"))
+    });
     let sift = sift_desc::SiftCorrespondences::new(config.sift.clone()).expect("valid config");
     g.bench_function("sift_correspondences", |bn| {
         bn.iter(|| {

@@ -83,9 +83,15 @@ fn report(dir: &Path, depth: usize) -> Result<(), String> {
         PreparedMap::new(&fa, &config.verify),
         PreparedMap::new(&fb, &config.verify),
     );
-    let unframed = |t: &Rigid2| {
-        let moved = t.apply(-ob) + oa;
-        Rigid2::new(t.theta, moved.x, moved.y)
+    let unframed = |t: &Rigid2| mapmerge::unframed(t, oa, ob);
+    // Where the screens' local search moves a placement, and how that pose verifies (as
+    // `register`'s screens do).
+    let searched = |t: &Rigid2| {
+        let moved = config
+            .search
+            .as_ref()
+            .map_or(*t, |sc| local_search(&pa, &pb, t, sc));
+        (moved, verify(&pa, &pb, &moved, &config.verify))
     };
     let centre = b.known_centroid().ok_or("map B has no known cell")?;
     let near = |t: &Rigid2| {
@@ -121,10 +127,7 @@ fn report(dir: &Path, depth: usize) -> Result<(), String> {
                 );
                 continue;
             };
-            let moved = config.search.as_ref().map_or(placements[i], |sc| {
-                local_search(&pa, &pb, &placements[i], sc)
-            });
-            let v = verify(&pa, &pb, &moved, &config.verify);
+            let (moved, v) = searched(&placements[i]);
             let error = displacement_error(&b, &unframed(&moved), &truth).unwrap_or(f64::NAN);
             println!(
                 "  {way}, {ranking}: near the truth {} of {}; searched {error:.2} px off, \
@@ -141,13 +144,7 @@ fn report(dir: &Path, depth: usize) -> Result<(), String> {
         }
         let passing = onto_a(&found.normalized)
             .iter()
-            .filter(|t| {
-                let moved = config
-                    .search
-                    .as_ref()
-                    .map_or(**t, |sc| local_search(&pa, &pb, t, sc));
-                verify(&pa, &pb, &moved, &config.verify).accepted(&config.verify)
-            })
+            .filter(|t| searched(t).1.accepted(&config.verify))
             .count();
         println!(
             "  {way}: {passing} of the normalised ranking's {} pass once searched",

@@ -1038,11 +1038,21 @@ pub struct SweepConfig {
     /// regression batch it registered 11 pairs more and lost none, and answered no pair that
     /// shares nothing (docs/EVALUATION.md, "The deep screen, off by default"). Only pairs
     /// where nothing passed pay for it, but they pay much: the declined bench pair (2048 x
-    /// 2048) takes about three times as long (694 ms against 227 ms). It stays off because
+    /// 2048) takes about three times as long (`cargo bench -p mapmerge --bench register`,
+    /// `end_to_end_partial_maps_declined_deep_screen`: 669 ms against 239 ms without it, on
+    /// 2 cores). It stays off because
     /// at five held-out seeds it answered five open-hall pairs of the simulated 30 % rows
     /// 206-233 px off (declined without it) for two more registered. `mapmerge estimate|merge
     /// --deep-screen` turns it on at 1000.
     pub deep_screened: usize,
+}
+
+impl SweepConfig {
+    /// How far down the normalised ranking the screen reaches: [`Self::screened`], or
+    /// [`Self::keep_normalized`] when that is more. The deep screen starts below it.
+    pub fn screen_depth(&self) -> usize {
+        self.screened.max(self.keep_normalized)
+    }
 }
 
 impl Default for SweepConfig {

@@ -46,5 +46,5 @@ pub use error::Error;
 pub use register::{
     APART_POINTS, Candidate, KindTotals, ManhattanRotation, Method, Origin, PairConfig,
     PolishConfig, RegisterConfig, Registration, RunnerUp, SpectrumRotation, Timings, TurnScan,
-    framed, mean_apart, refine_and_score, register, register_with,
+    framed, mean_apart, refine_and_score, register, register_with, unframed,
 };

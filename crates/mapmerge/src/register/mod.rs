@@ -597,8 +597,9 @@ pub fn framed(grid: &OccupancyGrid, margin: usize) -> (OccupancyGrid, DVec2) {
 }
 
 /// `t`, which maps pixels of B's frame onto A's frame, as a map of B's pixels onto A's, the
-/// frames' cells `(0, 0)` lying at `oa` in A and `ob` in B: `p -> t(p - ob) + oa`.
-fn unframed(t: &Rigid2, oa: DVec2, ob: DVec2) -> Rigid2 {
+/// frames' cells `(0, 0)` lying at `oa` in A and `ob` in B (as [`framed`] gives them):
+/// `p -> t(p - ob) + oa`.
+pub fn unframed(t: &Rigid2, oa: DVec2, ob: DVec2) -> Rigid2 {
     let moved = t.apply(-ob) + oa;
     Rigid2::new(t.theta, moved.x, moved.y)
 }

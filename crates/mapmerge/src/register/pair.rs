@@ -390,10 +390,7 @@ impl<'m> PairRun<'m> {
             } else {
                 (&self.pa, &self.pb)
             };
-            let count = sweep
-                .screened
-                .max(sweep.keep_normalized)
-                .max(sweep.deep_screened);
+            let count = sweep.screen_depth().max(sweep.deep_screened);
             sweep_placements(field, moving, sweep, count)
         })
     }
@@ -417,7 +414,7 @@ impl<'m> PairRun<'m> {
             return Vec::new();
         };
         let found = self.sweep(sweep, reverse);
-        let screened = sweep.screened.max(sweep.keep_normalized);
+        let screened = sweep.screen_depth();
         let normalized = &found.normalized[..found.normalized.len().min(screened)];
         let mut out: Vec<Placement> = Self::onto_a(&found.plain, reverse)
             .into_iter()
@@ -440,7 +437,7 @@ impl<'m> PairRun<'m> {
         let Some(sweep) = &self.config.sweep else {
             return Vec::new();
         };
-        let screened = sweep.screened.max(sweep.keep_normalized);
+        let screened = sweep.screen_depth();
         let deeper: Vec<Rigid2> = [false, true]
             .into_iter()
             .flat_map(|reverse| {
@@ -502,7 +499,7 @@ impl<'m> PairRun<'m> {
             }
             // Still nothing passed: deeper down both rankings (see
             // `SweepConfig::deep_screened`).
-            if sweep.deep_screened > sweep.screened.max(sweep.keep_normalized) && {
+            if sweep.deep_screened > sweep.screen_depth() && {
                 self.rank(candidates);
                 !candidates.first().is_some_and(|c| c.accepted)
             } {
