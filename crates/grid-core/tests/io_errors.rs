@@ -142,6 +142,31 @@ fn truncated_p5() {
     assert_fails(&path, "truncated: expected 12 bytes of pixel data, found 3");
 }
 
+/// A damaged image named by a YAML: the error names the image, what is wrong with it, and the
+/// YAML the user typed, as a missing image's does.
+#[test]
+fn a_damaged_image_named_in_yaml_names_both_files() {
+    let (dir, yaml) = yaml_case(GOOD_KEYS);
+    let image = write(&dir, "map.pgm", b"P5\n3 2\n255\n\x00\x00\x00\x00");
+    assert_eq!(
+        err(&yaml),
+        format!(
+            "{}: truncated: expected 6 bytes of pixel data, found 4 (image named in {})",
+            image.display(),
+            yaml.display()
+        )
+    );
+    let image = write(&dir, "map.pgm", b"");
+    assert_eq!(
+        err(&yaml),
+        format!(
+            "{}: empty file (0 bytes) (image named in {})",
+            image.display(),
+            yaml.display()
+        )
+    );
+}
+
 #[test]
 fn truncated_header() {
     let dir = TempDir::new().unwrap();

@@ -198,18 +198,27 @@ pub fn read_image(
     // A directory opens, and fails on the first read.
     let head = reader.fill_buf().map_err(io_error)?;
     let raster = if head.is_empty() {
-        return Err(format_error(image_path, "empty file (0 bytes)"));
+        Err(format_error(image_path, "empty file (0 bytes)"))
     } else if head.starts_with(b"\x89PNG") {
-        raster::read_png(reader, image_path, options.max_cells)?
+        raster::read_png(reader, image_path, options.max_cells)
     } else if head[0] == b'P' {
-        pnm::read_pnm(&mut reader, image_path, options.max_cells)?
+        pnm::read_pnm(&mut reader, image_path, options.max_cells)
     } else {
-        return Err(format_error(
+        Err(format_error(
             image_path,
             "not a PGM/PNM or PNG image (unrecognised file signature)",
-        ));
+        ))
     };
-    raster.to_grid(metadata, image_path)
+    raster
+        .and_then(|r| r.to_grid(metadata, image_path))
+        .map_err(|e| match (e, yaml) {
+            // As for the I/O errors above: the image's content is at fault, and the YAML named it.
+            (Error::Format { path, reason }, Some(y)) => Error::Format {
+                path,
+                reason: format!("{reason} (image named in {})", y.display()),
+            },
+            (e, _) => e,
+        })
 }
 
 /// `Err(Error::AllUnknown)` when `grid` has no free or occupied cell: a map that cannot be
