@@ -499,21 +499,18 @@ mod tests {
     }
 
     fn placed(tx: f64, accepted: bool) -> Candidate {
-        Candidate {
-            transform: Rigid2::new(0.0, tx, 0.0),
-            ransac_inliers: 0,
-            ransac_confidence: 0.0,
-            verification: Verification {
-                wall_lift: 0.9,
-                wall_support: 100,
-                acceptance_index: 0.98,
-                ..Verification::default()
-            },
+        let verification = Verification {
+            wall_lift: 0.9,
+            wall_support: 100,
+            acceptance_index: 0.98,
+            ..Verification::default()
+        };
+        Candidate::scored(
+            Rigid2::new(0.0, tx, 0.0),
+            verification,
             accepted,
-            stands_out: false,
-            origin: Origin::Sweep,
-            refined: true,
-        }
+            Origin::Sweep,
+        )
     }
 
     #[test]

@@ -132,6 +132,28 @@ pub struct Candidate {
     pub refined: bool,
 }
 
+impl Candidate {
+    /// A placement from `origin`, refined and scored as `verification`, passing or not as
+    /// `accepted` says: no RANSAC support (a whole-map placement), not standing out.
+    pub fn scored(
+        transform: Rigid2,
+        verification: Verification,
+        accepted: bool,
+        origin: Origin,
+    ) -> Self {
+        Self {
+            transform,
+            ransac_inliers: 0,
+            ransac_confidence: 0.0,
+            verification,
+            accepted,
+            stands_out: false,
+            origin,
+            refined: true,
+        }
+    }
+}
+
 /// Which stage proposed a candidate; serialised in lower case (`"ransac"`, ...), as the
 /// `hypothesis` field of `mapmerge estimate --json`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]

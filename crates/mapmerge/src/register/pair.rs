@@ -279,16 +279,8 @@ impl<'m> PairRun<'m> {
         (transform, verification): (Rigid2, Verification),
         origin: Origin,
     ) -> Candidate {
-        Candidate {
-            transform,
-            ransac_inliers: 0,
-            ransac_confidence: 0.0,
-            accepted: verification.accepted(&self.config.verify),
-            stands_out: false,
-            verification,
-            origin,
-            refined: true,
-        }
+        let accepted = verification.accepted(&self.config.verify);
+        Candidate::scored(transform, verification, accepted, origin)
     }
 
     /// Each of `starts` refined and scored, the best kept.

@@ -292,15 +292,13 @@ fn a_twin_is_a_rival_only_if_it_fits_about_as_well() {
         acceptance_index: 0.99,
         ..Verification::default()
     };
-    let twin = |verification: Verification| Candidate {
-        transform: Rigid2::new(1.6, 40.0, 0.0),
-        ransac_inliers: 0,
-        ransac_confidence: 0.0,
-        verification,
-        accepted: true,
-        stands_out: false,
-        origin: Origin::Symmetry,
-        refined: true,
+    let twin = |verification: Verification| {
+        Candidate::scored(
+            Rigid2::new(1.6, 40.0, 0.0),
+            verification,
+            true,
+            Origin::Symmetry,
+        )
     };
     let config = VerifyConfig::default();
     // The exact copy of a small room (a case proptest found): the best fits every wall,
@@ -350,11 +348,8 @@ fn a_twin_is_a_rival_only_if_it_fits_about_as_well() {
 #[test]
 fn a_placement_stands_out_only_if_every_distinct_one_fits_clearly_worse() {
     // Candidates placed `tx` px to the right of the first; `apart` is that distance.
-    let at = |tx: f64, wide: f64, acceptance_index: f64| Candidate {
-        transform: Rigid2::new(0.0, tx, 0.0),
-        ransac_inliers: 0,
-        ransac_confidence: 0.0,
-        verification: Verification {
+    let at = |tx: f64, wide: f64, acceptance_index: f64| {
+        let verification = Verification {
             wall_lift: wide - 0.2,
             wide_wall_lift: wide,
             wall_support: 2000,
@@ -362,11 +357,13 @@ fn a_placement_stands_out_only_if_every_distinct_one_fits_clearly_worse() {
             overlap_fraction: 0.4,
             wall_density: 0.05,
             ..Verification::default()
-        },
-        accepted: false,
-        stands_out: false,
-        origin: Origin::Sweep,
-        refined: true,
+        };
+        Candidate::scored(
+            Rigid2::new(0.0, tx, 0.0),
+            verification,
+            false,
+            Origin::Sweep,
+        )
     };
     let apart = |x: &Rigid2, y: &Rigid2| (x.tx - y.tx).abs();
     let config = VerifyConfig::default();
@@ -517,20 +514,19 @@ fn refining_only_the_placements_that_fit_best_keeps_the_answer() {
 
 #[test]
 fn the_runner_up_is_the_best_ranked_candidate_clearly_apart_from_the_first() {
-    let placed = |tx: f64, lift: f64, accepted: bool| Candidate {
-        transform: Rigid2::new(0.0, tx, 0.0),
-        ransac_inliers: 0,
-        ransac_confidence: 0.0,
-        verification: Verification {
+    let placed = |tx: f64, lift: f64, accepted: bool| {
+        let verification = Verification {
             wall_lift: lift,
             wall_support: 400,
             acceptance_index: 0.98,
             ..Verification::default()
-        },
-        accepted,
-        stands_out: false,
-        origin: Origin::Sweep,
-        refined: true,
+        };
+        Candidate::scored(
+            Rigid2::new(0.0, tx, 0.0),
+            verification,
+            accepted,
+            Origin::Sweep,
+        )
     };
     // Best first: the answer, a placement 3 px from it (one answer), then two apart.
     let r = Registration {
