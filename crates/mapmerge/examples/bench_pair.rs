@@ -7,8 +7,9 @@
 //! ```
 //!
 //! Pairs: `cic` (`end_to_end`), `warehouse`, `crops` (`end_to_end_overlapping_crops`),
-//! `partial` (`end_to_end_partial_maps`, the hard pair) and `declined`
-//! (`end_to_end_partial_maps_declined`). The count of runs defaults to 5. Set
+//! `partial` (`end_to_end_partial_maps`, the hard pair), `declined`
+//! (`end_to_end_partial_maps_declined`) and `declined-deep` (the same with the deep screen on,
+//! `end_to_end_partial_maps_declined_deep_screen`). The count of runs defaults to 5. Set
 //! `RAYON_NUM_THREADS=1` for a profile of one thread. Instruction counts (callgrind) do not
 //! depend on the machine's load, unlike times: the way to compare two builds on a shared
 //! machine. Building the pair (loading, warping, simulating the partial maps) is outside the
@@ -31,9 +32,11 @@ fn main() -> ExitCode {
         "warehouse" => pairs::warehouse_pair(),
         "crops" => pairs::overlapping_crops(),
         "partial" => pairs::partial_pair(0.5),
-        "declined" => pairs::partial_pair(0.0),
+        "declined" | "declined-deep" => pairs::partial_pair(0.0),
         _ => {
-            eprintln!("usage: bench_pair cic|warehouse|crops|partial|declined [RUNS]");
+            eprintln!(
+                "usage: bench_pair cic|warehouse|crops|partial|declined|declined-deep [RUNS]"
+            );
             return ExitCode::from(2);
         }
     };
@@ -45,7 +48,13 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    let config = RegisterConfig::default();
+    let mut config = RegisterConfig::default();
+    if name == "declined-deep"
+        && let Some(sweep) = config.pair.sweep.as_mut()
+    {
+        // As `mapmerge --deep-screen` sets it.
+        sweep.deep_screened = 1000;
+    }
     for _ in 0..runs {
         let t = Instant::now();
         let answer = register(&a, &b, &config).expect("the default settings are valid");
