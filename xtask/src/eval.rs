@@ -1019,6 +1019,8 @@ struct Outcome {
     /// Each map's share of lone wall cells (`mapmerge::ascent::lone_wall_share`, A then B):
     /// how speckled its walls are, which decides the clean-walls and clean-fit bars.
     lone_wall_shares: Option<[f64; 2]>,
+    /// The true rotation of B onto A, in degrees in [0, 360) (pairs that must be registered).
+    truth_rotation_deg: Option<f64>,
     accepted: bool,
     rotation_error_deg: Option<f64>,
     displacement_error_px: Option<f64>,
@@ -1398,6 +1400,7 @@ fn run_case(
         seed,
         achieved_overlap: 0.0,
         lone_wall_shares: None,
+        truth_rotation_deg: None,
         accepted: false,
         rotation_error_deg: None,
         displacement_error_px: None,
@@ -1454,6 +1457,8 @@ fn run_case(
             let mut out = blank(method);
             out.achieved_overlap = pair.overlap();
             out.lone_wall_shares = Some(lone_wall_shares);
+            out.truth_rotation_deg =
+                (!row.expect_decline).then(|| truth.theta.to_degrees().rem_euclid(360.0));
             out.truth_verification = truth_verification;
             out.truth_refined_drift_px = truth_refined_drift_px;
             out.truth_refined_verification = truth_refined_verification;
@@ -1518,6 +1523,90 @@ fn separation_error(
     let towards_b = (truth.apply(cb) - ca).try_normalize()?;
     let e = answer.apply(cb) - truth.apply(cb);
     Some([e.dot(towards_b), towards_b.perp_dot(e)])
+}
+
+/// The bin of a true rotation `deg` in [0, 360): eight bins of 45 degrees.
+fn rotation_bin(deg: f64) -> usize {
+    ((deg.rem_euclid(360.0) / 45.0) as usize).min(7)
+}
+
+/// The bin of how far a rotation `deg` lies from the nearest quarter turn, where the maps'
+/// grids line up: five bins of 9 degrees over 0-45.
+fn axis_bin(deg: f64) -> usize {
+    let quarter = deg.rem_euclid(90.0);
+    ((quarter.min(90.0 - quarter) / 9.0) as usize).min(4)
+}
+
+/// Success by the true rotation, over every pair of the run that must be registered (the
+/// issue asks for the accuracy "at every rotation angle"): one table by the angle itself,
+/// one by its distance from the nearest quarter turn. Empty when no such pair ran.
+fn angle_tables(outcomes: &[Outcome], methods: &[Method]) -> Result<String> {
+    let mut out = String::new();
+    let placed: Vec<&Outcome> = outcomes
+        .iter()
+        .filter(|o| o.error.is_none() && o.truth_rotation_deg.is_some())
+        .collect();
+    if placed.is_empty() {
+        return Ok(out);
+    }
+    /// A table's heading, its column's name, its count of bins, the bin of an angle and a
+    /// bin's label.
+    type Binning = (
+        &'static str,
+        &'static str,
+        usize,
+        fn(f64) -> usize,
+        fn(usize) -> String,
+    );
+    let tables: [Binning; 2] = [
+        (
+            "the true rotation",
+            "true rotation (deg)",
+            8,
+            rotation_bin,
+            |i| format!("{}-{}", 45 * i, 45 * (i + 1)),
+        ),
+        (
+            "the true rotation's distance from the nearest quarter turn",
+            "from a quarter turn (deg)",
+            5,
+            axis_bin,
+            |i| format!("{}-{}", 9 * i, 9 * (i + 1)),
+        ),
+    ];
+    for (heading, column, bins, bin, label) in tables {
+        writeln!(
+            out,
+            "\nPairs that must be registered, by {heading}:\n\n| method | {column} | cases | success | accepted |\n|---|---|---|---|---|"
+        )?;
+        for m in methods {
+            for i in 0..bins {
+                let os: Vec<&&Outcome> = placed
+                    .iter()
+                    .filter(|o| o.method == m.to_string())
+                    .filter(|o| o.truth_rotation_deg.is_some_and(|d| bin(d) == i))
+                    .collect();
+                let n = os.len();
+                let pct = |k: usize| {
+                    if n == 0 {
+                        "-".to_string()
+                    } else {
+                        format!("{:.0}%", 100.0 * k as f64 / n as f64)
+                    }
+                };
+                let success = os.iter().filter(|o| o.success).count();
+                let accepted = os.iter().filter(|o| o.accepted).count();
+                writeln!(
+                    out,
+                    "| {m} | {} | {n} | {} | {} |",
+                    label(i),
+                    pct(success),
+                    pct(accepted)
+                )?;
+            }
+        }
+    }
+    Ok(out)
 }
 
 fn median(mut v: Vec<f64>) -> Option<f64> {
@@ -1776,6 +1865,7 @@ pub fn run(args: EvalArgs) -> Result<()> {
             )?;
         }
     }
+    table.push_str(&angle_tables(&outcomes, &args.methods)?);
     crate::emit(&table)?;
     if let Some(prefix) = &args.out {
         // Appended, not `with_extension`: a prefix such as `runs/mean_2.5` keeps its dot.
@@ -1807,9 +1897,29 @@ mod tests {
         crisp_sliver_values, export, finite, fraction, grey_values, non_negative,
         non_negative_or_inf, positive, share_kept, slug, small_overlap_values, stand_out_values,
     };
+    use super::{axis_bin, rotation_bin};
     use clap::Parser;
     use grid_core::io::{LoadOptions, load_map};
     use mapsim::{CaseConfig, generate_case};
+
+    #[test]
+    fn rotations_fall_in_their_bins() {
+        assert_eq!(rotation_bin(0.0), 0);
+        assert_eq!(rotation_bin(44.999), 0);
+        assert_eq!(rotation_bin(45.0), 1);
+        assert_eq!(rotation_bin(359.999), 7);
+        assert_eq!(rotation_bin(-10.0), 7);
+        assert_eq!(rotation_bin(360.0), 0);
+        // From the nearest quarter turn: 95 and 265 degrees are 5 from one.
+        assert_eq!(axis_bin(0.0), 0);
+        assert_eq!(axis_bin(95.0), 0);
+        assert_eq!(axis_bin(265.0), 0);
+        assert_eq!(axis_bin(9.0), 1);
+        assert_eq!(axis_bin(80.5), 1);
+        assert_eq!(axis_bin(45.0), 4);
+        assert_eq!(axis_bin(224.0), 4);
+        assert_eq!(axis_bin(-30.0), 3);
+    }
 
     #[test]
     fn row_labels_become_folder_names() {
