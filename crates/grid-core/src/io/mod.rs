@@ -182,43 +182,50 @@ pub fn read_image(
     options: &LoadOptions,
     yaml: Option<&Path>,
 ) -> Result<OccupancyGrid> {
-    let io_error = |source: std::io::Error| Error::Io {
-        path: image_path.to_path_buf(),
-        source: match yaml {
-            // Say where the name came from: the user typed the YAML's name, not this one.
-            Some(y) => std::io::Error::new(
-                source.kind(),
-                format!("{source} (image named in {})", y.display()),
-            ),
-            None => source,
+    let read = || -> Result<OccupancyGrid> {
+        let io_error = |source: std::io::Error| Error::Io {
+            path: image_path.to_path_buf(),
+            source,
+        };
+        let file = File::open(image_path).map_err(io_error)?;
+        let mut reader = BufReader::new(file);
+        // A directory opens, and fails on the first read.
+        let head = reader.fill_buf().map_err(io_error)?;
+        let raster = if head.is_empty() {
+            return Err(format_error(image_path, "empty file (0 bytes)"));
+        } else if head.starts_with(b"\x89PNG") {
+            raster::read_png(reader, image_path, options.max_cells)?
+        } else if head[0] == b'P' {
+            pnm::read_pnm(&mut reader, image_path, options.max_cells)?
+        } else {
+            return Err(format_error(
+                image_path,
+                "not a PGM/PNM or PNG image (unrecognised file signature)",
+            ));
+        };
+        raster.to_grid(metadata, image_path)
+    };
+    read().map_err(|e| match yaml {
+        Some(y) => named_in(e, y),
+        None => e,
+    })
+}
+
+/// `e`, an error about an image that `yaml` named, saying so: the user typed the YAML's name,
+/// not the image's. Every error of [`read_image`] that names a file names the image.
+fn named_in(e: Error, yaml: &Path) -> Error {
+    let also = format!("(image named in {})", yaml.display());
+    match e {
+        Error::Io { path, source } => Error::Io {
+            path,
+            source: std::io::Error::new(source.kind(), format!("{source} {also}")),
         },
-    };
-    let file = File::open(image_path).map_err(io_error)?;
-    let mut reader = BufReader::new(file);
-    // A directory opens, and fails on the first read.
-    let head = reader.fill_buf().map_err(io_error)?;
-    let raster = if head.is_empty() {
-        Err(format_error(image_path, "empty file (0 bytes)"))
-    } else if head.starts_with(b"\x89PNG") {
-        raster::read_png(reader, image_path, options.max_cells)
-    } else if head[0] == b'P' {
-        pnm::read_pnm(&mut reader, image_path, options.max_cells)
-    } else {
-        Err(format_error(
-            image_path,
-            "not a PGM/PNM or PNG image (unrecognised file signature)",
-        ))
-    };
-    raster
-        .and_then(|r| r.to_grid(metadata, image_path))
-        .map_err(|e| match (e, yaml) {
-            // As for the I/O errors above: the image's content is at fault, and the YAML named it.
-            (Error::Format { path, reason }, Some(y)) => Error::Format {
-                path,
-                reason: format!("{reason} (image named in {})", y.display()),
-            },
-            (e, _) => e,
-        })
+        Error::Format { path, reason } => Error::Format {
+            path,
+            reason: format!("{reason} {also}"),
+        },
+        e => e,
+    }
 }
 
 /// `Err(Error::AllUnknown)` when `grid` has no free or occupied cell: a map that cannot be
